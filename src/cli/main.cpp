@@ -1,0 +1,64 @@
+// cli/main.cpp — the `vdbsplat` binary: dispatches subcommands, and is the one
+// place that turns an Error (or any exception) into "vdbsplat: error: …" and a
+// non-zero exit.
+#include <exception>
+#include <iostream>
+#include <new>
+#include <string>
+
+#include "cli/commands.h"
+#include "util/error.h"
+
+namespace {
+
+const char* kUsage =
+    "usage: vdbsplat <command> [options]   (vdbsplat <command> --help for details)\n"
+    "\n"
+    "commands:\n"
+    "  render    render a .vdb grid to PNG or EXR (reference, hybrid, splat, point)\n"
+    "  info      describe every grid in a .vdb file\n"
+    "  generate  write a test volume (checkerbox, marschner-lobb, sphere, cloud)\n"
+    "  convert   turn a raw volume (x fastest) into a sparse .vdb\n"
+    "  tables    regenerate or check the footprint and reindex tables\n"
+    "  bench     time hybrid, splat-only and point-only at the standard views\n"
+    "  compare   image metrics (PSNR, RMSE) of an image against a reference\n";
+
+int dispatch(const std::string& command, const vdbsplat::cli::Argv& args) {
+    using namespace vdbsplat::cli;
+    if (command == "render") return runRender(args);
+    if (command == "info") return runInfo(args);
+    if (command == "generate") return runGenerate(args);
+    if (command == "convert") return runConvert(args);
+    if (command == "tables") return runTables(args);
+    if (command == "bench") return runBench(args);
+    if (command == "compare") return runCompare(args);
+    throw vdbsplat::Error("unknown command '" + command + "' (try: vdbsplat --help)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) {
+        std::cerr << kUsage;
+        return 2;
+    }
+    const std::string command = argv[1];
+    if (command == "--help" || command == "-h" || command == "help") {
+        std::cout << kUsage;
+        return 0;
+    }
+    if (command == "--version") {
+        std::cout << "vdbsplat " << VDBSPLAT_VERSION << "\n";
+        return 0;
+    }
+    try {
+        return dispatch(command, vdbsplat::cli::Argv(argv + 2, argv + argc));
+    } catch (const vdbsplat::Error& e) {
+        std::cerr << "vdbsplat: error: " << e.what() << "\n";
+    } catch (const std::bad_alloc&) {
+        std::cerr << "vdbsplat: error: out of memory\n";
+    } catch (const std::exception& e) {
+        std::cerr << "vdbsplat: error: " << e.what() << "\n";
+    }
+    return 1;
+}

@@ -1,0 +1,38 @@
+// footprint/kernel.h — the reconstruction kernel every mode shares (DESIGN §1).
+// Owns: the truncated Gaussian g, its normalisation to unit volume integral over
+// its truncated support, and its closed-form line integrals (the footprint F).
+//
+// Choice (documented in docs/kernel.md): s_g = 0.65 voxel, R = 2.0 voxels
+// (≈ 3.08 s_g). The partition-of-unity ripple of the untruncated Gaussian is
+// 2·exp(−2π²s_g²) ≈ 4.8e−4 (DESIGN §1).
+//
+// Units: "voxel units" — distances divided by the voxel size h.
+#pragma once
+
+namespace vdbsplat {
+
+struct Kernel {
+    static constexpr double kSigma = 0.65;   ///< s_g, the Gaussian's standard deviation (voxels)
+    static constexpr double kRadius = 2.0;   ///< R, the truncation radius (voxels)
+    static constexpr const char* kName = "gaussian-s0.65-R2.0";  ///< written into table headers
+
+    /// @brief 1 / ∫_{|x|<R} exp(−|x|²/(2 s_g²)) dV, so that ∫ g dV = 1 (voxel units).
+    static double normalization();
+
+    /// @brief g(x) for |x|² = @p s2 (voxel units²); 0 outside the support.
+    static double value(double s2);
+
+    /// @brief F(ρ): the line integral of g along a full chord at distance ρ (voxel units)
+    /// from the centre; 0 for ρ ≥ R. Closed form with erf (DESIGN §3). ∫∫ F dA = 1.
+    static double footprint(double rho);
+
+    /// @brief The line integral of g along a ray at distance ρ from the centre,
+    /// between signed ray parameters @p t0 ≤ @p t1 measured from the closest point
+    /// (voxel units), clipped to the chord.
+    static double segmentIntegral(double rho, double t0, double t1);
+
+    /// @brief ∫∫ F over the plane, numerically; 1 up to quadrature error (used by tests).
+    static double footprintPlaneIntegral(int steps = 4096);
+};
+
+}  // namespace vdbsplat

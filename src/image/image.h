@@ -1,0 +1,44 @@
+// image/image.h — the output image and its files.
+// Owns: Image (linear, premultiplied RGBA float, row-major, y down) and writing
+// it as PNG (8-bit, sRGB-encoded, over black) or EXR (float, linear, with
+// metadata) through OpenImageIO, atomically: a temporary file in the same
+// folder, renamed into place, so a failure never leaves a partial image.
+#pragma once
+#include <glm/glm.hpp>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace vdbsplat {
+
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<glm::vec4> pixels;  ///< premultiplied linear RGBA, index y * width + x
+
+    Image() = default;
+    Image(int w, int h) : width(w), height(h), pixels(size_t(w) * size_t(h), glm::vec4(0.0f)) {}
+    glm::vec4& at(int x, int y) { return pixels[size_t(y) * width + x]; }
+    const glm::vec4& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
+};
+
+/// @brief sRGB transfer curve of a linear value in [0, 1] (values outside are clamped).
+float linearToSrgb(float v);
+/// @brief Inverse of linearToSrgb.
+float srgbToLinear(float v);
+
+/// @brief Writes @p image to @p path (.png or .exr, by extension) atomically.
+/// EXR files carry @p metadata as string attributes.
+/// @throw Error naming the path on an unknown extension or a write failure.
+void writeImage(const std::string& path, const Image& image,
+                const std::map<std::string, std::string>& metadata = {});
+
+/// @brief Reads a PNG (sRGB, decoded to linear) or EXR (linear) back into an Image.
+/// @throw Error naming the path when it cannot be read.
+Image readImage(const std::string& path);
+
+/// @brief Checks that @p path has an extension writeImage supports (before any work is done).
+/// @throw Error naming the path otherwise.
+void checkImagePath(const std::string& path);
+
+}  // namespace vdbsplat

@@ -1,0 +1,28 @@
+// util/parse.h — strict parsing of numbers and number lists from text.
+// Owns: the conversions every flag and file format uses, so "1.5x", "nan" or
+// "1,2" where three values are needed are rejected the same way everywhere.
+#pragma once
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace vdbsplat {
+
+/// @brief Parses a finite double; the whole string must be consumed.
+/// @throw Error "<what>: expected a number, got '<text>'".
+double parseDouble(std::string_view text, const std::string& what);
+
+/// @brief Parses a base-10 integer in [lo, hi]; the whole string must be consumed.
+/// @throw Error naming @p what when malformed or out of range.
+long long parseInt(std::string_view text, const std::string& what,
+                   long long lo, long long hi);
+
+/// @brief Parses exactly @p count finite doubles separated by commas ("1,2,3").
+/// @throw Error naming @p what when the count or any number is wrong.
+std::vector<double> parseDoubleList(std::string_view text, const std::string& what, size_t count);
+
+/// @brief Parses "WxH" (e.g. "400x400") with each side in [1, maxSide].
+/// @throw Error naming @p what when malformed or out of range.
+void parseSize(std::string_view text, const std::string& what, int maxSide, int& width, int& height);
+
+}  // namespace vdbsplat

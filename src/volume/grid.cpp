@@ -1,0 +1,164 @@
+// volume/grid.cpp — loading and validating sparse grids (see grid.h).
+#include "volume/grid.h"
+
+#include <openvdb/io/File.h>
+
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+#include <unistd.h>
+
+#include "util/error.h"
+
+namespace vdbsplat {
+
+namespace {
+
+bool isScalarType(const std::string& type) { return type == "float" || type == "double"; }
+
+/// Opens @p path as a VDB (no delayed loading, so a truncated file fails here, not mid-render).
+void openFile(openvdb::io::File& file, const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
+    if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a regular file");
+    try {
+        file.open(/*delayLoad=*/false);
+    } catch (const std::exception& e) {
+        throw Error(path + ": not a readable VDB file (" + std::string(e.what()) + ")");
+    }
+}
+
+/// Converts a double grid to a float grid of the same topology, transform and metadata.
+openvdb::FloatGrid::Ptr toFloatGrid(const openvdb::GridBase::Ptr& base) {
+    if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) return f;
+    auto d = openvdb::gridPtrCast<openvdb::DoubleGrid>(base);
+    auto tree = std::make_shared<openvdb::FloatTree>(d->tree());  // value-converting deep copy
+    auto grid = openvdb::FloatGrid::create(tree);
+    grid->setTransform(d->transform().copy());
+    grid->setName(d->getName());
+    grid->setGridClass(d->getGridClass());
+    return grid;
+}
+
+/// The index→world matrix of a linear transform with uniform scale; refuses anything else.
+glm::dmat4 linearUniformMap(const openvdb::math::Transform& transform, const std::string& label, double& voxelSize) {
+    if (!transform.isLinear()) throw Error(label + ": transform is not linear (frustum maps are not supported)");
+    const openvdb::Mat4d m = transform.baseMap()->getAffineMap()->getMat4();
+    glm::dmat4 map(1.0);
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) map[c][r] = m(c, r);  // OpenVDB is row-vector: world = [i j k 1]·m
+    const glm::dvec3 a0(map[0]), a1(map[1]), a2(map[2]);
+    const double h0 = glm::length(a0), h1 = glm::length(a1), h2 = glm::length(a2);
+    if (!(h0 > 0.0) || !std::isfinite(h0 + h1 + h2)) throw Error(label + ": transform has a zero or non-finite voxel size");
+    const double tol = 1e-6 * h0;
+    if (std::abs(h1 - h0) > tol || std::abs(h2 - h0) > tol)
+        throw Error(label + ": non-uniform voxel size (" + std::to_string(h0) + ", " + std::to_string(h1) + ", " +
+                    std::to_string(h2) + ") is not supported");
+    if (std::abs(glm::dot(a0, a1)) > tol * h0 || std::abs(glm::dot(a0, a2)) > tol * h0 ||
+        std::abs(glm::dot(a1, a2)) > tol * h0)
+        throw Error(label + ": transform has shear, which is not supported");
+    voxelSize = h0;
+    return map;
+}
+
+/// Replaces non-finite active values by 0 and measures the finite value range.
+void sanitizeValues(Volume& v) {
+    float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
+    uint64_t bad = 0;
+    for (auto it = v.grid->beginValueOn(); it; ++it) {
+        const float x = *it;
+        if (!std::isfinite(x)) {
+            it.setValue(0.0f);
+            bad += it.getVoxelCount();
+            continue;
+        }
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+    }
+    v.nonFiniteCount = bad;
+    if (lo > hi) lo = hi = 0.0f;  // every value was non-finite
+    v.valueMin = lo;
+    v.valueMax = hi;
+}
+
+}  // namespace
+
+void initOpenVdb() {
+    static std::once_flag once;
+    std::call_once(once, [] { openvdb::initialize(); });
+}
+
+void Volume::worldBounds(glm::dvec3& lo, glm::dvec3& hi) const {
+    lo = glm::dvec3(std::numeric_limits<double>::max());
+    hi = -lo;
+    const openvdb::Coord a = indexBox.min(), b = indexBox.max();
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec4 p((corner & 1 ? b.x() + 0.5 : a.x() - 0.5), (corner & 2 ? b.y() + 0.5 : a.y() - 0.5),
+                           (corner & 4 ? b.z() + 0.5 : a.z() - 0.5), 1.0);
+        const glm::dvec3 w(indexToWorld * p);
+        lo = glm::min(lo, w);
+        hi = glm::max(hi, w);
+    }
+}
+
+Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label) {
+    Volume v;
+    v.grid = std::move(grid);
+    v.name = v.grid->getName();
+    const std::string where = label + (v.name.empty() ? "" : " grid '" + v.name + "'");
+    v.indexToWorld = linearUniformMap(v.grid->transform(), where, v.voxelSize);
+    v.worldToIndex = glm::inverse(v.indexToWorld);
+    v.activeVoxels = v.grid->activeVoxelCount();
+    if (v.activeVoxels == 0) throw Error(where + ": grid has no active voxels");
+    v.indexBox = v.grid->evalActiveVoxelBoundingBox();
+    sanitizeValues(v);
+    return v;
+}
+
+Volume loadVolume(const std::string& path, const std::string& gridName) {
+    initOpenVdb();
+    openvdb::io::File file(path);
+    openFile(file, path);
+    openvdb::GridBase::Ptr base;
+    try {
+        const auto metas = file.readAllGridMetadata();
+        std::string chosen;
+        for (const auto& meta : *metas) {
+            if (!gridName.empty() ? meta->getName() == gridName : isScalarType(meta->valueType())) {
+                if (!isScalarType(meta->valueType()))
+                    throw Error(path + ": grid '" + gridName + "' holds " + meta->valueType() +
+                                " values; only float and double grids can be rendered");
+                chosen = meta->getName();
+                break;
+            }
+        }
+        if (chosen.empty() && !gridName.empty()) throw Error(path + ": no grid named '" + gridName + "'");
+        if (chosen.empty() && metas->empty()) throw Error(path + ": file holds no grids");
+        if (chosen.empty()) throw Error(path + ": no float or double grid in the file");
+        base = file.readGrid(chosen);
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(path + ": corrupt or truncated VDB file (" + std::string(e.what()) + ")");
+    }
+    file.close();
+    Volume v = makeVolume(toFloatGrid(base), path);
+    v.file = path;
+    return v;
+}
+
+void writeVolume(const std::string& path, openvdb::FloatGrid::Ptr grid) {
+    initOpenVdb();
+    const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+    try {
+        openvdb::io::File file(tmp);
+        file.write({grid});
+        file.close();
+        std::filesystem::rename(tmp, path);
+    } catch (const std::exception& e) {
+        std::remove(tmp.c_str());
+        throw Error(path + ": cannot write VDB file (" + std::string(e.what()) + ")");
+    }
+}
+
+}  // namespace vdbsplat

@@ -1,0 +1,52 @@
+// volume/grid.h — reading sparse OpenVDB grids (never densified).
+// Owns: Volume (one float grid plus what the renderer needs to know about it),
+// loading a named or the first scalar grid from a .vdb file (float or double;
+// double is converted to a float tree of the same topology), validating its
+// transform, and describing every grid of a file (`vdbsplat info`).
+#pragma once
+#include <openvdb/openvdb.h>
+
+#include <glm/glm.hpp>
+#include <string>
+#include <vector>
+
+namespace vdbsplat {
+
+/// @brief One scalar grid ready to render.
+struct Volume {
+    openvdb::FloatGrid::Ptr grid;   ///< values as float; non-finite values were set to 0 (see nonFiniteCount)
+    std::string file;               ///< the file it came from ("" if generated in memory)
+    std::string name;               ///< the grid's name
+    double voxelSize = 1.0;         ///< h, world units per voxel (uniform; non-uniform scale is refused)
+    glm::dmat4 indexToWorld{1.0};   ///< affine map from index space (voxel centres at integers) to world
+    glm::dmat4 worldToIndex{1.0};   ///< its inverse
+    openvdb::CoordBBox indexBox;    ///< bounding box of the active voxels (inclusive)
+    uint64_t activeVoxels = 0;      ///< active voxel count (active tiles counted as their voxels)
+    uint64_t nonFiniteCount = 0;    ///< active voxels whose NaN/inf value was replaced by 0
+    float valueMin = 0.f, valueMax = 1.f;  ///< range of finite active values
+
+    /// @brief World-space bounds of the active voxels' centres, widened by half a voxel.
+    void worldBounds(glm::dvec3& lo, glm::dvec3& hi) const;
+};
+
+/// @brief Calls openvdb::initialize() once (thread-safe, idempotent).
+void initOpenVdb();
+
+/// @brief Loads grid @p gridName (or, if empty, the first float/double scalar grid) from @p path.
+/// @throw Error naming the file and the problem: missing, not a VDB, truncated or corrupt,
+/// no float grid, no grid of that name, an empty grid, or a transform that is not linear
+/// with uniform scale.
+Volume loadVolume(const std::string& path, const std::string& gridName = "");
+
+/// @brief Wraps an in-memory float grid (tests, generators) as a Volume, validating it as loadVolume does.
+Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label = "<memory>");
+
+/// @brief A human-readable description of every grid in @p path (`vdbsplat info`).
+/// @throw Error as loadVolume for unreadable files.
+std::string describeFile(const std::string& path);
+
+/// @brief Writes @p grid to @p path atomically (temporary file, then rename).
+/// @throw Error naming the path on failure.
+void writeVolume(const std::string& path, openvdb::FloatGrid::Ptr grid);
+
+}  // namespace vdbsplat
