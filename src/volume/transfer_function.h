@@ -9,6 +9,8 @@
 // length (σ·h), the unit every renderer integrates in.
 #pragma once
 #include <glm/glm.hpp>
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -21,42 +23,83 @@ struct Classified {
 };
 
 /// @brief A baked transfer function: a dense table over the normalised value.
+///
+/// Entry i holds the function at x_i = i / (kSize − 1); a raw value v maps to the
+/// continuous index (v − valueMin) · (kSize − 1) / (valueMax − valueMin), so
+/// valueMin lands exactly on entry 0 and valueMax exactly on entry kSize − 1,
+/// and values outside the range clamp to the end entries. A degenerate range
+/// (valueMax ≤ valueMin: a grid holding one value) maps every value to x = 1.
 class ClassificationTable {
 public:
     static constexpr int kSize = 4096;
     ClassificationTable() = default;
+    /// @param entries   kSize entries (x_i = i / (kSize − 1)); an empty vector classifies all to zero
+    /// @param valueMin  raw value mapped to x = 0
+    /// @param valueMax  raw value mapped to x = 1
     ClassificationTable(std::vector<Classified> entries, float valueMin, float valueMax);
-    /// @brief Classifies a raw voxel value (normalised with the grid's range); non-finite → σ = 0.
-    Classified operator()(float value) const;
+
+    /// @brief Classifies a raw voxel value (normalised with the grid's range); non-finite → all zero.
+    /// Linear interpolation between the two nearest entries; hot path, inline.
+    Classified operator()(float value) const {
+        if (!std::isfinite(value) || entries_.empty()) return {};
+        const float x = std::clamp(value * scale_ + offset_, 0.f, float(kSize - 1));
+        const int i = std::min(int(x), kSize - 2);
+        const float t = x - float(i);
+        const Classified& a = entries_[size_t(i)];
+        const Classified& b = entries_[size_t(i) + 1];
+        return {a.color + t * (b.color - a.color), a.sigma + t * (b.sigma - a.sigma)};
+    }
+    /// @brief Extinction only (σ·h per voxel length) — for passes that need no colour.
+    float sigma(float value) const { return (*this)(value).sigma; }
     /// @brief True if no value maps to a positive extinction (nothing to render).
     bool empty() const;
+    /// @brief The continuous table index a raw value maps to (unclamped; for tests).
+    float indexOf(float value) const { return value * scale_ + offset_; }
+
 private:
     std::vector<Classified> entries_;
-    float valueMin_ = 0.f, scale_ = 1.f;
+    float scale_ = float(kSize - 1);  ///< index = value · scale_ + offset_
+    float offset_ = 0.f;
 };
 
+/// @brief A piecewise-linear transfer function over the normalised value x ∈ [0, 1].
 class TransferFunction {
 public:
-    struct ColorPoint { float x; glm::vec3 rgb; };
-    struct ExtinctionPoint { float x; float sigma; };
+    struct ColorPoint { float x; glm::vec3 rgb; };       ///< linear RGB in [0, 1]
+    struct ExtinctionPoint { float x; float sigma; };    ///< σ ≥ 0 in the function's units
+
+    /// @brief Largest transfer-function file fromSpec() reads.
+    static constexpr size_t kMaxFileBytes = size_t(16) << 20;
 
     /// @brief A built-in preset: "grey", "ct-bone", "fire" (see presetNames()).
     /// @throw Error "unknown transfer function preset '<name>' (choose …)".
     static TransferFunction preset(const std::string& name);
+    /// @brief Names of the built-in presets, in a fixed order.
     static std::vector<std::string> presetNames();
     /// @brief A preset name or a JSON file (vdbsplat format, or a ParaView colour map).
-    /// @throw Error naming the file and the reason when invalid.
+    /// @throw Error naming the file and the reason when invalid, or
+    ///        "unknown transfer function preset or file '<s>' (presets: …)".
     static TransferFunction fromSpec(const std::string& presetOrFile);
     /// @brief Parses JSON text; @p origin names the source in error messages.
+    /// @throw Error "<origin>: <reason>" (one line) when invalid.
     static TransferFunction fromJson(const std::string& text, const std::string& origin);
+    /// @brief Builds a function from points (validated as a file would be).
+    /// @throw Error "<name>: <reason>" when the points are invalid.
+    static TransferFunction fromPoints(std::string name, std::vector<ColorPoint> colors,
+                                       std::vector<ExtinctionPoint> extinction, bool worldUnits = false);
 
-    /// @brief Colour and extinction at normalised value @p x ∈ [0, 1] (piecewise linear, clamped).
+    /// @brief Colour and extinction at normalised value @p x ∈ [0, 1] (piecewise linear, clamped;
+    /// non-finite x → all zero). Extinction is in the function's own units (see worldUnits()).
     Classified evaluate(float x) const;
     /// @brief Bakes a table for a grid with values in [valueMin, valueMax] and voxel size @p h.
+    /// @throw Error when the range is not finite or (world units) h is not finite and positive.
     ClassificationTable bake(float valueMin, float valueMax, double voxelSize) const;
 
     const std::string& name() const { return name_; }
-    /// @brief The whole function as compact JSON (for EXR metadata and stats).
+    bool worldUnits() const { return worldUnits_; }
+    const std::vector<ColorPoint>& colors() const { return colors_; }
+    const std::vector<ExtinctionPoint>& extinction() const { return extinction_; }
+    /// @brief The whole function as compact JSON (for EXR metadata and stats); fromJson reads it back.
     std::string toJson() const;
 
 private:
