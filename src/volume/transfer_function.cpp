@@ -310,26 +310,29 @@ TransferFunction greyPreset() {
                                         {{0.f, 0.f}, {1.f, 0.5f}});
 }
 
-/// CT bone/tissue, tuned on the Engine and Bonsai CTs (uint8 → [0, 1]):
-/// x < 0.1 air and scanner noise (σ = 0); 0.1–0.35 soft tissue / leaves / partial-volume
-/// edges, faint reddish (σ ≤ 0.01); 0.35–0.62 bone / engine block (the Engine's main peak
-/// is at 0.50–0.62), ivory, σ rising to 0.06 so a 50-voxel wall is τ ≈ 3; 0.62–1 dense
-/// bone / metal inserts / the Bonsai's pot, near white, σ up to 0.4.
+/// CT bone/tissue, tuned on the Engine and Bonsai CTs (uint8 → [0, 1]; histograms in
+/// docs/transfer-functions.md): x < 0.12 air and scanner noise (σ = 0); 0.12–0.35 soft
+/// tissue / leaves / partial-volume edges, faint reddish (σ ≤ 0.008); 0.35–0.62 bone / the
+/// engine block (the Engine's main peak is 0.50–0.62), tan to ivory, σ rising to 0.03 so a
+/// 100-voxel path through the block is τ ≈ 3 (translucent, not a flat silhouette);
+/// 0.62–1 dense bone / metal inserts / the Bonsai's pot, near white, σ 0.2–0.4 (opaque
+/// within a few voxels, so they read as solid parts inside the translucent block).
 TransferFunction ctBonePreset() {
     return TransferFunction::fromPoints("ct-bone",
                                         {{0.00f, {0.00f, 0.00f, 0.00f}},
-                                         {0.10f, {0.30f, 0.06f, 0.04f}},
+                                         {0.12f, {0.30f, 0.06f, 0.04f}},
                                          {0.25f, {0.75f, 0.28f, 0.16f}},
-                                         {0.40f, {0.90f, 0.62f, 0.42f}},
-                                         {0.60f, {0.95f, 0.86f, 0.70f}},
+                                         {0.45f, {0.90f, 0.55f, 0.35f}},
+                                         {0.62f, {0.95f, 0.80f, 0.62f}},
+                                         {0.75f, {1.00f, 0.95f, 0.90f}},
                                          {1.00f, {1.00f, 1.00f, 1.00f}}},
                                         {{0.00f, 0.000f},
-                                         {0.10f, 0.000f},
-                                         {0.20f, 0.004f},
-                                         {0.35f, 0.010f},
-                                         {0.50f, 0.040f},
-                                         {0.62f, 0.060f},
-                                         {0.75f, 0.250f},
+                                         {0.12f, 0.000f},
+                                         {0.20f, 0.003f},
+                                         {0.35f, 0.008f},
+                                         {0.50f, 0.020f},
+                                         {0.62f, 0.030f},
+                                         {0.75f, 0.200f},
                                          {1.00f, 0.400f}});
 }
 
