@@ -105,15 +105,19 @@ ImageMetrics compareImages(const Image& image, const Image& reference) {
     checkSizes(image, reference);
     ImageMetrics m;
     double sum = 0.0;
-    for (size_t i = 0; i < image.pixels.size(); ++i) {
-        const glm::vec4& a = image.pixels[i];
-        const glm::vec4& b = reference.pixels[i];
-        if (hasNan(a) || hasNan(b)) ++m.nonFinitePixels;
-        for (int c = 0; c < 3; ++c) {
-            const double d = double(display(a[c])) - double(display(b[c]));
-            sum += d * d;
-            m.maxAbsError = std::max(m.maxAbsError, std::abs(d));
+    for (int y = 0; y < image.height; ++y) {
+        double row = 0.0;  // per-row partial sums keep rounding small on large images
+        for (int x = 0; x < image.width; ++x) {
+            const glm::vec4& a = image.at(x, y);
+            const glm::vec4& b = reference.at(x, y);
+            if (hasNan(a) || hasNan(b)) ++m.nonFinitePixels;
+            for (int c = 0; c < 3; ++c) {
+                const double d = double(display(a[c])) - double(display(b[c]));
+                row += d * d;
+                m.maxAbsError = std::max(m.maxAbsError, std::abs(d));
+            }
         }
+        sum += row;
     }
     m.mse = sum / (3.0 * double(image.pixels.size()));
     m.rmse = std::sqrt(m.mse);

@@ -279,6 +279,10 @@ json parseJsonText(const std::string& text, const std::string& origin) {
         return json::parse(text);
     } catch (const json::parse_error& e) {
         throw Error(fail(origin, "not valid JSON at " + positionOf(text, e.byte) + ": " + parseReason(e.what())));
+    } catch (const json::exception& e) {  // e.g. out_of_range 406: a number overflowing a double
+        const std::string what = e.what();
+        const size_t end = what.find("] ");
+        throw Error(fail(origin, "not valid JSON: " + oneLine(end == std::string::npos ? what : what.substr(end + 2))));
     }
 }
 
