@@ -1,7 +1,149 @@
-// cli/cmd_render.cpp — `vdbsplat render` (placeholder until its issue lands).
+// cli/cmd_render.cpp — `vdbsplat render`: flags → RenderSettings → render() → image (+ stats).
+// Everything is validated (flags, output path, volume, transfer function, camera)
+// before any rendering starts, and outputs are written atomically.
+#include <tbb/global_control.h>
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "cli/args.h"
 #include "cli/commands.h"
+#include "image/image.h"
+#include "render/render.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/parse.h"
 
 namespace vdbsplat::cli {
-int runRender(const Argv&) { throw Error("'render' is not implemented yet"); }
+
+namespace {
+
+const char* kHelp =
+    "usage: vdbsplat render FILE.vdb -o OUT.png|OUT.exr [options]\n"
+    "\n"
+    "  -o FILE            output image: .png (8-bit sRGB over black) or .exr (float linear RGBA + metadata)\n"
+    "  --grid NAME        grid to render (default: the first float or double grid)\n"
+    "  --mode MODE        hybrid (default) | splat | point | reference\n"
+    "  --size WxH         image size in pixels (default 400x400)\n"
+    "  --tf PRESET|FILE   transfer function: grey (default), ct-bone, fire, or a JSON file\n"
+    "  --eye X,Y,Z        camera position (world); default: frame the grid from a fixed oblique view\n"
+    "  --look-at X,Y,Z    point looked at (default: the centre of the grid's bounds)\n"
+    "  --up X,Y,Z         up vector (default 0,0,1)\n"
+    "  --fov DEG          vertical field of view (default 30)\n"
+    "  --distance K       multiplies the framing distance (8 far, 1 framed, 0.35 close)\n"
+    "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
+    "  --footprint P      table (default) | exact: per-pixel ray-centre distance instead of the (i, alpha) table\n"
+    "  --show-primitives  tint splats red, points keep their colour\n"
+    "  --spp N            reference: rays per pixel (default 16, rounded up to a square)\n"
+    "  --threads N        worker threads (default: all cores); the image does not depend on it\n"
+    "  --stats FILE.json  write settings, timings and primitive counts as JSON\n"
+    "  -v                 print the statistics in one line\n";
+
+glm::dvec3 parseVec3(const std::string& text, const std::string& flag) {
+    const auto v = parseDoubleList(text, flag, 3);
+    return {v[0], v[1], v[2]};
+}
+
+RenderSettings settingsFrom(const Args& args) {
+    RenderSettings s;
+    if (auto v = args.get("--mode")) s.mode = parseRenderMode(*v);
+    if (auto v = args.get("--size")) parseSize(*v, "--size", 16384, s.camera.width, s.camera.height);
+    if (auto v = args.get("--tf")) s.transferFunction = *v;
+    if (auto v = args.get("--grid")) s.gridName = *v;
+    if (auto v = args.get("--fov")) s.camera.fovDeg = parseDouble(*v, "--fov");
+    if (auto v = args.get("--distance")) s.camera.distance = parseDouble(*v, "--distance");
+    if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
+    if (auto v = args.get("--spp")) s.spp = int(parseInt(*v, "--spp", 1, 1024));
+    if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
+    if (auto v = args.get("--footprint")) {
+        if (*v == "table") s.footprint = FootprintPath::Table;
+        else if (*v == "exact") s.footprint = FootprintPath::Exact;
+        else throw Error("--footprint: expected 'table' or 'exact', got '" + *v + "'");
+    }
+    s.showPrimitives = args.has("--show-primitives");
+    if (args.has("--look-at") && !args.has("--eye")) throw Error("--look-at: needs --eye");
+    if (args.has("--up") && !args.has("--eye")) throw Error("--up: needs --eye");
+    if (auto v = args.get("--eye")) {
+        s.camera.hasEye = true;
+        s.camera.eye = parseVec3(*v, "--eye");
+        if (auto u = args.get("--up")) s.camera.up = parseVec3(*u, "--up");
+    }
+    s.validate();
+    return s;
+}
+
+std::string oneLine(const RenderStats& st, const RenderSettings& s) {
+    char buf[512];
+    const uint64_t drawn = st.points + st.splats;
+    std::snprintf(buf, sizeof buf,
+                  "%s %dx%d: %.3f s, %llu active voxels, %llu points, %llu splats (%.1f%%), %llu culled; "
+                  "stream %.3f project %.3f rasterize %.3f composite %.3f s",
+                  toString(s.mode).c_str(), s.camera.width, s.camera.height, st.seconds,
+                  (unsigned long long)st.activeVoxels, (unsigned long long)st.points, (unsigned long long)st.splats,
+                  drawn ? 100.0 * st.splats / drawn : 0.0, (unsigned long long)st.culled, st.streamSeconds,
+                  st.projectSeconds, st.rasterizeSeconds, st.compositeSeconds);
+    return buf;
+}
+
+}  // namespace
+
+int runRender(const Argv& argv) {
+    const Args args(argv,
+                    {"-o", "--grid", "--mode", "--size", "--tf", "--eye", "--look-at", "--up", "--fov", "--distance",
+                     "--threads", "--spp", "--stats", "--threshold", "--footprint"},
+                    {"-v", "--show-primitives"});
+    if (args.wantsHelp()) {
+        std::cout << kHelp;
+        return 0;
+    }
+    const std::string input = args.onePositional("input .vdb file");
+    const std::string output = args.require("-o");
+    RenderSettings settings = settingsFrom(args);
+    checkImagePath(output);
+    const auto statsPath = args.get("--stats");
+
+    std::unique_ptr<tbb::global_control> threads;
+    if (settings.threads > 0)
+        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
+
+    const TransferFunction tf = TransferFunction::fromSpec(settings.transferFunction);
+    const Volume volume = loadVolume(input, settings.gridName);
+    if (auto v = args.get("--eye")) {
+        if (auto l = args.get("--look-at")) {
+            settings.camera.lookAt = parseVec3(*l, "--look-at");
+        } else {
+            glm::dvec3 lo, hi;
+            volume.worldBounds(lo, hi);
+            settings.camera.lookAt = 0.5 * (lo + hi);
+        }
+    }
+    const Camera camera = cameraFor(volume, settings);  // validates eye/look-at/up before the work
+
+    RenderStats stats;
+    const Image image = render(volume, tf, settings, stats);
+
+    nlohmann::json meta = settings.toJson();
+    meta.update(stats.toJson());
+    meta["width"] = camera.width();
+    meta["height"] = camera.height();
+    meta["input"] = input;
+    meta["grid"] = volume.name;
+    meta["camera"] = camera.describe();
+    meta["transfer_function"] = nlohmann::json::parse(tf.toJson());
+    if (volume.nonFiniteCount) meta["non_finite_voxels_zeroed"] = volume.nonFiniteCount;
+    writeImage(output, image,
+               {{"settings", settings.toJson().dump()},
+                {"camera", camera.describe()},
+                {"mode", toString(settings.mode)},
+                {"transfer_function", tf.toJson()},
+                {"seconds", std::to_string(stats.seconds)}});
+    if (statsPath) writeTextFileAtomic(*statsPath, meta.dump(2) + "\n");
+    if (args.has("-v")) std::cout << oneLine(stats, settings) << "\n";
+    if (volume.nonFiniteCount)
+        std::cerr << "vdbsplat: warning: " << input << ": " << volume.nonFiniteCount
+                  << " active voxels with NaN or infinite values were treated as zero\n";
+    return 0;
+}
+
 }  // namespace vdbsplat::cli

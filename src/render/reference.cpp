@@ -1,0 +1,288 @@
+// render/reference.cpp — the supersampled ray integrator (see reference.h, DESIGN §1).
+#include "render/reference.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+#include "footprint/kernel.h"
+#include "footprint/prefilter.h"
+#include "util/error.h"
+
+namespace vdbsplat {
+
+namespace {
+
+constexpr double kR = Kernel::kRadius;
+constexpr double kS = Kernel::kSigma;
+/// Ring of depth bins; must exceed the span of unfinished bins, 2(W + R) + √3 ≤ 16 voxels = 64 bins.
+constexpr int kRingSize = 256;
+
+/// E(u) = erf(u / (s√2)) for u ∈ [−R, R], tabulated: the kernel's line-integral primitive.
+class ErfTable {
+public:
+    ErfTable() {
+        for (int k = 0; k < kN; ++k) values_[k] = std::erf((-kR + k * kStep) / (kS * std::numbers::sqrt2));
+    }
+    double operator()(double u) const {
+        const double x = std::clamp((u + kR) / kStep, 0.0, double(kN - 1));
+        const int k = std::min(int(x), kN - 2);
+        const double t = x - k;
+        return values_[k] + t * (values_[k + 1] - values_[k]);
+    }
+
+private:
+    static constexpr int kN = 4097;
+    static constexpr double kStep = 2.0 * kR / (kN - 1);
+    std::array<double, kN> values_;
+};
+
+const ErfTable& erfTable() {
+    static const ErfTable table;  // immutable after construction
+    return table;
+}
+
+/// Deterministic hash of three integers to [0, 1) (splitmix64 finaliser).
+double hash01(uint64_t a, uint64_t b, uint64_t c) {
+    uint64_t z = a * 0x9E3779B97F4A7C15ull ^ (b + 0x632BE59BD9B4E019ull) * 0xBF58476D1CE4E5B9ull ^ c * 0x94D049BB133111EBull;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return double(z >> 11) * (1.0 / 9007199254740992.0);
+}
+
+}  // namespace
+
+RayIntegrator::RayIntegrator(const Volume& volume, const ClassificationTable& table)
+    : volume_(volume), table_(table), accessor_(volume.grid->getConstAccessor()), bins_(kRingSize) {}
+
+bool RayIntegrator::clip(const glm::dvec3& o, const glm::dvec3& d, double& tEnter, double& tExit) const {
+    const openvdb::Coord lo = volume_.indexBox.min(), hi = volume_.indexBox.max();
+    tEnter = 0.0;
+    tExit = std::numeric_limits<double>::max();
+    for (int a = 0; a < 3; ++a) {
+        const double boxLo = lo[a] - kR, boxHi = hi[a] + kR;
+        if (std::abs(d[a]) < 1e-15) {
+            if (o[a] < boxLo || o[a] > boxHi) return false;
+            continue;
+        }
+        double t0 = (boxLo - o[a]) / d[a], t1 = (boxHi - o[a]) / d[a];
+        if (t0 > t1) std::swap(t0, t1);
+        tEnter = std::max(tEnter, t0);
+        tExit = std::min(tExit, t1);
+    }
+    return tEnter < tExit;
+}
+
+/// Visits every active kernel whose support sphere the ray crosses, slice by slice along the
+/// major axis m of d, front to back. visit(tc, rho, value) per kernel; sliceDone(tFrontier)
+/// after each slice with the ray parameter before which no later kernel deposits; it returns
+/// false to stop early.
+template <typename Visit>
+void RayIntegrator::gather(const glm::dvec3& o, const glm::dvec3& d, double tEnter, double tExit, Visit&& visit) {
+    const int m = std::abs(d.x) >= std::abs(d.y) ? (std::abs(d.x) >= std::abs(d.z) ? 0 : 2)
+                                                  : (std::abs(d.y) >= std::abs(d.z) ? 1 : 2);
+    const int a = (m + 1) % 3, b = (m + 2) % 3;
+    const double dm = d[m];
+    // Lateral half-extents of the slice's kernel disc: |w_a| ≤ R·sqrt(1 − d_b²)/|d_m|.
+    const double ea = kR * std::sqrt(std::max(0.0, 1.0 - d[b] * d[b])) / std::abs(dm);
+    const double eb = kR * std::sqrt(std::max(0.0, 1.0 - d[a] * d[a])) / std::abs(dm);
+    const double reach = std::sqrt(ea * ea + eb * eb) + kR;  // a slice's kernels start at t ≥ t_k − reach
+    const openvdb::Coord lo = volume_.indexBox.min(), hi = volume_.indexBox.max();
+    const double m0 = o[m] + dm * tEnter, m1 = o[m] + dm * tExit;
+    const int step = dm > 0 ? 1 : -1;
+    int kFirst = int(std::floor(std::min(m0, m1) - kR)), kLast = int(std::ceil(std::max(m0, m1) + kR));
+    kFirst = std::max(kFirst, lo[m]);
+    kLast = std::min(kLast, hi[m]);
+    if (kFirst > kLast) return;
+    if (step < 0) std::swap(kFirst, kLast);
+    openvdb::Coord ijk;
+    for (int k = kFirst;; k += step) {
+        const double tk = (k - o[m]) / dm;
+        const glm::dvec3 p = o + d * tk;
+        const int aLo = std::max(int(std::ceil(p[a] - ea)), lo[a]), aHi = std::min(int(std::floor(p[a] + ea)), hi[a]);
+        const int bLo = std::max(int(std::ceil(p[b] - eb)), lo[b]), bHi = std::min(int(std::floor(p[b] + eb)), hi[b]);
+        ijk[m] = k;
+        for (int ia = aLo; ia <= aHi; ++ia) {
+            ijk[a] = ia;
+            for (int ib = bLo; ib <= bHi; ++ib) {
+                ijk[b] = ib;
+                const glm::dvec3 w = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) - o;
+                const double tc = glm::dot(w, d);
+                const double rho2 = glm::dot(w, w) - tc * tc;
+                if (rho2 >= kR * kR) continue;
+                float value;
+                if (!accessor_.probeValue(ijk, value)) continue;
+                visit.kernel(tc, rho2, value);
+            }
+        }
+        if (k == kLast) break;
+        const double tNext = (k + step - o[m]) / dm;
+        if (!visit.sliceDone(tNext - reach)) return;
+    }
+}
+
+namespace {
+
+/// The per-ray state of the bin compositor: a ring of depth bins from tEnter on, composited
+/// front to back as the slice front passes them (DESIGN §4: C += T·α·c, T *= 1 − α).
+struct BinCompositor {
+    std::vector<RayIntegrator::Bin>& bins;
+    const ClassificationTable& table;
+    double tEnter;
+    glm::dvec3 color{0.0};
+    double transmittance = 1.0;
+    int64_t next = 0;     // first bin not yet composited
+    int64_t filled = -1;  // last bin deposited into
+
+    int64_t binOf(double t) const { return int64_t(std::floor((t - tEnter) / kBinLength)); }
+
+    void compositeUpTo(int64_t end) {
+        for (; next < end; ++next) {
+            RayIntegrator::Bin& bin = bins[next % kRingSize];
+            if (bin.tau > 0.0) {
+                const double alpha = -std::expm1(-bin.tau);
+                color += transmittance * alpha * (bin.emission / bin.tau);
+                transmittance *= 1.0 - alpha;
+            }
+            bin = RayIntegrator::Bin{};
+        }
+    }
+
+    /// Deposits one kernel's exact line integral, bin by bin: τ_bin = σ_k ∫_bin g dt (erf).
+    void kernel(double tc, double rho2, float value) {
+        const Classified cls = table(value);
+        if (!(cls.sigma > 0.f)) return;
+        const ErfTable& E = erfTable();
+        const double halfChord = std::sqrt(kR * kR - rho2);
+        const double tStart = std::max(tc - halfChord, tEnter), tEnd = tc + halfChord;
+        if (tEnd <= tStart) return;
+        // ∫ N e^{−(ρ²+u²)/2s²} du = N e^{−ρ²/2s²} · s√(π/2) · ΔE(u)
+        const double amplitude = cls.sigma * Kernel::normalization() * kS * std::sqrt(std::numbers::pi / 2.0) *
+                                 std::exp(-rho2 / (2.0 * kS * kS));
+        const glm::dvec3 c(cls.color);
+        int64_t j = binOf(tStart);
+        const int64_t jEnd = binOf(tEnd);
+        double prevE = E(tStart - tc);
+        if (j < next) {  // cannot happen by the reach bound; never write into a composited bin
+            j = next;
+            prevE = E(tEnter + j * kBinLength - tc);
+        }
+        if (jEnd >= next + kRingSize) compositeUpTo(jEnd - kRingSize + 1);  // ring guard, likewise
+        for (; j <= jEnd; ++j) {
+            const double curE = E(std::min(tEnter + (j + 1) * kBinLength, tEnd) - tc);
+            const double tau = amplitude * (curE - prevE);
+            prevE = curE;
+            RayIntegrator::Bin& bin = bins[j % kRingSize];
+            bin.tau += tau;
+            bin.emission += tau * c;
+        }
+        filled = std::max(filled, jEnd);
+    }
+
+    bool sliceDone(double frontier) {
+        compositeUpTo(std::min(binOf(frontier), filled + 1));
+        return transmittance >= kReferenceEpsilon;
+    }
+};
+
+}  // namespace
+
+glm::dvec4 RayIntegrator::integrate(const glm::dvec3& origin, const glm::dvec3& direction) {
+    const glm::dvec3 o = glm::dvec3(volume_.worldToIndex * glm::dvec4(origin, 1.0));
+    const glm::dvec3 d = glm::normalize(glm::dmat3(volume_.worldToIndex) * direction);
+    double tEnter, tExit;
+    if (!clip(o, d, tEnter, tExit)) return glm::dvec4(0.0);
+    std::fill(bins_.begin(), bins_.end(), Bin{});
+    BinCompositor compositor{bins_, table_, tEnter};
+    gather(o, d, tEnter, tExit, compositor);
+    compositor.compositeUpTo(compositor.filled + 1);
+    return glm::dvec4(compositor.color, 1.0 - compositor.transmittance);
+}
+
+double RayIntegrator::opticalDepth(const glm::dvec3& origin, const glm::dvec3& direction) {
+    const glm::dvec3 o = glm::dvec3(volume_.worldToIndex * glm::dvec4(origin, 1.0));
+    const glm::dvec3 d = glm::normalize(glm::dmat3(volume_.worldToIndex) * direction);
+    double tEnter, tExit;
+    if (!clip(o, d, tEnter, tExit)) return 0.0;
+    struct Visitor {
+        RayIntegrator* self;
+        double tEnter, sum = 0.0;
+        void kernel(double tc, double rho2, float value) {
+            const Classified cls = self->table_(value);
+            sum += cls.sigma * Kernel::segmentIntegral(std::sqrt(rho2), tEnter - tc, kR);
+        }
+        bool sliceDone(double) { return true; }
+    } visitor{this, tEnter};
+    gather(o, d, tEnter, tExit, visitor);
+    return visitor.sum;
+}
+
+Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
+                      RenderStats& stats) {
+    const auto start = std::chrono::steady_clock::now();
+    const int n = std::max(1, int(std::ceil(std::sqrt(double(spp)) - 1e-9)));  // strata per axis
+    const double sigmaP = std::sqrt(kPrefilterVariance);
+    const int border = int(std::ceil(kPrefilterCutoffSigmas * sigmaP));
+    const int W = camera.width(), H = camera.height();
+    const int sw = W + 2 * border;  // sample pixels per row
+    const double bytesPerRow = double(sw) * n * n * sizeof(glm::vec4);
+    if (bytesPerRow * (2 * border + 1) > double(1ull << 30))
+        throw Error("--spp: " + std::to_string(n * n) + " rays per pixel at width " + std::to_string(W) +
+                    " needs too much memory for the reference");
+    // Output rows per band, so a band's samples stay under ~128 MiB.
+    const int bandRows = std::clamp(int((128.0 * (1 << 20)) / bytesPerRow) - 2 * border, 1, H);
+    Image image(W, H);
+    std::vector<glm::vec4> samples;
+    const double cutoff2 = kPrefilterCutoffSigmas * kPrefilterCutoffSigmas * kPrefilterVariance;
+
+    for (int y0 = 0; y0 < H; y0 += bandRows) {
+        const int y1 = std::min(H, y0 + bandRows);
+        const int sy0 = y0 - border, sh = (y1 - y0) + 2 * border;
+        samples.assign(size_t(sw) * sh * n * n, glm::vec4(0.f));
+        const auto samplePos = [&](int px, int py, int s) {
+            const int sx = s % n, sy = s / n;
+            return PixelCoord(px + (sx + hash01(px, py, 2 * s)) / n, py + (sy + hash01(px, py, 2 * s + 1)) / n);
+        };
+        tbb::parallel_for(tbb::blocked_range<int>(0, sh, 1), [&](const tbb::blocked_range<int>& rows) {
+            RayIntegrator integrator(volume, table);
+            for (int r = rows.begin(); r < rows.end(); ++r)
+                for (int c = 0; c < sw; ++c)
+                    for (int s = 0; s < n * n; ++s) {
+                        const PixelCoord q = samplePos(c - border, sy0 + r, s);
+                        samples[(size_t(r) * sw + c) * n * n + s] =
+                            glm::vec4(integrator.integrate(camera.eye(), camera.worldRay(q)));
+                    }
+        });
+        // Band-limit by the prefilter h_p and sample at pixel centres (DESIGN §1).
+        tbb::parallel_for(tbb::blocked_range<int>(y0, y1, 1), [&](const tbb::blocked_range<int>& rows) {
+            for (int y = rows.begin(); y < rows.end(); ++y)
+                for (int x = 0; x < W; ++x) {
+                    const PixelCoord centre(x + 0.5, y + 0.5);
+                    glm::dvec4 sum(0.0);
+                    double weights = 0.0;
+                    for (int py = y - border; py <= y + border; ++py)
+                        for (int px = x - border; px <= x + border; ++px)
+                            for (int s = 0; s < n * n; ++s) {
+                                const PixelCoord q = samplePos(px, py, s);
+                                const double r2 = glm::dot(q - centre, q - centre);
+                                if (r2 > cutoff2) continue;
+                                const double w = std::exp(-0.5 * r2 / kPrefilterVariance);
+                                sum += w * glm::dvec4(samples[(size_t(py - sy0) * sw + (px + border)) * n * n + s]);
+                                weights += w;
+                            }
+                    image.at(x, y) = glm::vec4(sum / weights);
+                }
+        });
+    }
+    stats.rays += uint64_t(W + 2 * border) * (H + 2 * border) * n * n;
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return image;
+}
+
+}  // namespace vdbsplat

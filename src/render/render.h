@@ -1,0 +1,27 @@
+// render/render.h — the one entry point every caller renders through.
+// Owns: turning (volume, settings) into an image: baking the transfer function
+// for the grid's value range, building the camera, and dispatching to the mode
+// (reference, hybrid, splat, point). The command line, the benchmark and the
+// end-to-end tests all call render(), so they measure the same thing.
+#pragma once
+#include "camera/camera.h"
+#include "image/image.h"
+#include "render/settings.h"
+#include "volume/grid.h"
+#include "volume/transfer_function.h"
+
+namespace vdbsplat {
+
+/// @brief The value range a grid's values are normalised from before classification:
+/// [0, 1] when every finite active value lies in it, else the grid's [min, max].
+void normalizationRange(const Volume& volume, float& lo, float& hi);
+
+/// @brief The camera @p settings describe for @p volume (framing its world bounds by default).
+Camera cameraFor(const Volume& volume, const RenderSettings& settings);
+
+/// @brief Renders @p volume with @p settings (already validated) and transfer function @p tf.
+/// Uses the calling thread's TBB arena (the caller limits threads with tbb::global_control).
+/// @throw Error for settings the mode cannot honour.
+Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings, RenderStats& stats);
+
+}  // namespace vdbsplat

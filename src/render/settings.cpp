@@ -1,0 +1,77 @@
+// render/settings.cpp — validation and JSON echo of the render settings.
+#include "render/settings.h"
+
+#include <cmath>
+
+#include "util/error.h"
+
+namespace vdbsplat {
+
+RenderMode parseRenderMode(const std::string& name) {
+    if (name == "hybrid") return RenderMode::Hybrid;
+    if (name == "splat") return RenderMode::Splat;
+    if (name == "point") return RenderMode::Point;
+    if (name == "reference") return RenderMode::Reference;
+    throw Error("--mode: unknown mode '" + name + "' (choose hybrid, splat, point, reference)");
+}
+
+std::string toString(RenderMode mode) {
+    switch (mode) {
+        case RenderMode::Hybrid: return "hybrid";
+        case RenderMode::Splat: return "splat";
+        case RenderMode::Point: return "point";
+        case RenderMode::Reference: return "reference";
+    }
+    return "?";
+}
+
+void RenderSettings::validate() const {
+    constexpr int kMaxSide = 16384;
+    if (camera.width < 1 || camera.height < 1 || camera.width > kMaxSide || camera.height > kMaxSide)
+        throw Error("--size: each side must be in [1, " + std::to_string(kMaxSide) + "]");
+    if (!(camera.fovDeg > 0.0 && camera.fovDeg < 170.0)) throw Error("--fov: must be in (0, 170) degrees");
+    if (!(std::isfinite(camera.distance) && camera.distance > 0.0 && camera.distance < 1e6))
+        throw Error("--distance: must be a positive number");
+    if (threads < 0 || threads > 1024) throw Error("--threads: must be in [0, 1024]");
+    if (spp < 1 || spp > 1024) throw Error("--spp: must be in [1, 1024]");
+    if (!(std::isfinite(threshold) && threshold > 0.0)) throw Error("--threshold: must be a positive number of pixels");
+}
+
+nlohmann::json RenderSettings::toJson() const {
+    nlohmann::json j;
+    j["mode"] = toString(mode);
+    j["width"] = camera.width;
+    j["height"] = camera.height;
+    j["fov"] = camera.fovDeg;
+    if (camera.hasEye) {
+        j["eye"] = {camera.eye.x, camera.eye.y, camera.eye.z};
+        j["look_at"] = {camera.lookAt.x, camera.lookAt.y, camera.lookAt.z};
+        j["up"] = {camera.up.x, camera.up.y, camera.up.z};
+    } else {
+        j["distance"] = camera.distance;
+    }
+    j["tf"] = transferFunction;
+    j["grid"] = gridName;
+    j["spp"] = spp;
+    j["threshold"] = threshold;
+    j["footprint"] = footprint == FootprintPath::Table ? "table" : "exact";
+    j["show_primitives"] = showPrimitives;
+    return j;
+}
+
+nlohmann::json RenderStats::toJson() const {
+    nlohmann::json j;
+    j["seconds"] = seconds;
+    j["active_voxels"] = activeVoxels;
+    j["points"] = points;
+    j["splats"] = splats;
+    j["culled"] = culled;
+    const uint64_t drawn = points + splats;
+    j["splat_fraction"] = drawn ? double(splats) / double(drawn) : 0.0;
+    if (rays) j["rays"] = rays;
+    j["stage_seconds"] = {{"stream", streamSeconds}, {"project", projectSeconds},
+                          {"rasterize", rasterizeSeconds}, {"composite", compositeSeconds}};
+    return j;
+}
+
+}  // namespace vdbsplat

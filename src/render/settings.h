@@ -1,0 +1,45 @@
+// render/settings.h — everything that determines an image, in one struct.
+// Owns: RenderSettings (validated once, echoed whole into EXR metadata and
+// --stats JSON so every run is reproducible from its own output — the OpenVDB
+// options-struct pattern) and RenderStats (what a render measured).
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "camera/camera.h"
+
+namespace vdbsplat {
+
+enum class RenderMode { Reference, Hybrid, Splat, Point };
+enum class FootprintPath { Table, Exact };
+
+/// @throw Error "unknown mode '<name>' (choose hybrid, splat, point, reference)".
+RenderMode parseRenderMode(const std::string& name);
+std::string toString(RenderMode mode);
+
+struct RenderSettings {
+    RenderMode mode = RenderMode::Hybrid;
+    CameraSpec camera;
+    std::string transferFunction = "grey";  ///< preset name or JSON file
+    std::string gridName;                   ///< empty: the first float/double grid
+    int threads = 0;                        ///< 0: all cores
+    int spp = 16;                           ///< reference: rays per pixel (rounded to a square)
+    double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
+    FootprintPath footprint = FootprintPath::Table;
+    bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
+
+    /// @throw Error naming the flag of the first invalid value.
+    void validate() const;
+    nlohmann::json toJson() const;
+};
+
+struct RenderStats {
+    double seconds = 0.0;
+    uint64_t activeVoxels = 0;
+    uint64_t points = 0, splats = 0, culled = 0;
+    uint64_t rays = 0;  ///< reference: rays traced
+    double streamSeconds = 0.0, projectSeconds = 0.0, rasterizeSeconds = 0.0, compositeSeconds = 0.0;
+    nlohmann::json toJson() const;
+};
+
+}  // namespace vdbsplat

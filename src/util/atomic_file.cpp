@@ -1,0 +1,33 @@
+// util/atomic_file.cpp — temporary file + rename (see atomic_file.h).
+#include "util/atomic_file.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "util/error.h"
+
+namespace vdbsplat {
+
+void writeTextFileAtomic(const std::string& path, const std::string& text) {
+    const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) throw Error(path + ": cannot open for writing");
+        out << text;
+        out.flush();
+        if (!out) {
+            std::remove(tmp.c_str());
+            throw Error(path + ": write failed");
+        }
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::remove(tmp.c_str());
+        throw Error(path + ": cannot rename temporary file into place: " + ec.message());
+    }
+}
+
+}  // namespace vdbsplat

@@ -1,0 +1,12 @@
+// util/atomic_file.h — writing small text outputs (JSON stats) without ever
+// leaving a partial file: write a temporary file beside the target, rename it.
+#pragma once
+#include <string>
+
+namespace vdbsplat {
+
+/// @brief Writes @p text to @p path atomically.
+/// @throw Error naming the path when the folder is missing or the write fails.
+void writeTextFileAtomic(const std::string& path, const std::string& text);
+
+}  // namespace vdbsplat

@@ -1,0 +1,37 @@
+// tests/render/scenes.h — small in-memory scenes with known answers for render tests.
+#pragma once
+#include <openvdb/openvdb.h>
+#include <openvdb/math/Transform.h>
+
+#include "volume/grid.h"
+#include "volume/transfer_function.h"
+
+namespace vdbsplat::test {
+
+/// A table that classifies every value in [0, 1] as extinction @p sigma (per voxel length), colour @p color.
+inline ClassificationTable constantTable(float sigma, glm::vec3 color = glm::vec3(1.f)) {
+    return ClassificationTable(std::vector<Classified>(ClassificationTable::kSize, Classified{color, sigma}), 0.f, 1.f);
+}
+
+/// A table σ(v) = @p sigmaMax · v (grey colour v), so values select the extinction.
+inline ClassificationTable rampTable(float sigmaMax) {
+    std::vector<Classified> e(ClassificationTable::kSize);
+    for (int i = 0; i < ClassificationTable::kSize; ++i) {
+        const float v = float(i) / (ClassificationTable::kSize - 1);
+        e[i] = Classified{glm::vec3(v), sigmaMax * v};
+    }
+    return ClassificationTable(std::move(e), 0.f, 1.f);
+}
+
+/// Active voxels of value @p value over the index box [lo, hi] (inclusive), voxel size @p h.
+inline Volume boxVolume(openvdb::Coord lo, openvdb::Coord hi, float value = 1.f, double h = 1.0) {
+    initOpenVdb();
+    auto grid = openvdb::FloatGrid::create(0.f);
+    grid->setName("density");
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
+    grid->denseFill(openvdb::CoordBBox(lo, hi), value, true);
+    grid->tree().voxelizeActiveTiles();
+    return makeVolume(grid, "test-box");
+}
+
+}  // namespace vdbsplat::test
