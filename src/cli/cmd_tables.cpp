@@ -1,7 +1,54 @@
-// cli/cmd_tables.cpp — `vdbsplat tables` (placeholder until its issue lands).
+// cli/cmd_tables.cpp — `vdbsplat tables`: regenerate (--out DIR) or verify (--check [DIR])
+// the footprint and reindex tables (DESIGN §3; footprint/tables.h).
+#include <cstdio>
+#include <iostream>
+
+#include "cli/args.h"
 #include "cli/commands.h"
+#include "footprint/kernel.h"
+#include "footprint/tables.h"
 #include "util/error.h"
 
 namespace vdbsplat::cli {
-int runTables(const Argv&) { throw Error("'tables' is not implemented yet"); }
+
+namespace {
+const char* kHelp =
+    "usage: vdbsplat tables --out DIR      write footprint.table and reindex.table into DIR\n"
+    "       vdbsplat tables --check [DIR]  verify DIR (default: the shipped tables/ directory):\n"
+    "                                      header, kernel, checksum, and byte-for-byte equality\n"
+    "                                      with a fresh build; exits non-zero on any mismatch\n"
+    "\n"
+    "The footprint table is F(d²), the kernel's line integral at normalised ray-centre\n"
+    "distance d; the reindex table is d²(i², α) for α in [0°, 15°] (DESIGN §3).\n";
+
+int writeTables(const std::string& dir) {
+    const Tables t = buildTables();
+    saveTables(t, dir);
+    std::printf("wrote %s/%s (kernel %s, %d intervals in d², max error %.3e)\n", dir.c_str(), kFootprintTableFile,
+                Kernel::kName, t.footprint.intervals(), t.footprint.maxAbsError());
+    std::printf("wrote %s/%s (%d × %d intervals in i² × α ∈ [0°, %g°], max error %.3e)\n", dir.c_str(),
+                kReindexTableFile, t.reindex.intervalsI2(), t.reindex.intervalsAlpha(), t.reindex.alphaMaxDeg(),
+                t.reindex.maxAbsError());
+    return 0;
+}
+}  // namespace
+
+int runTables(const Argv& argv) {
+    const Args args(argv, {"--out"}, {"--check"});
+    if (args.wantsHelp()) {
+        std::cout << kHelp;
+        return 0;
+    }
+    const bool check = args.has("--check"), out = args.has("--out");
+    if (check == out) throw Error("tables: give exactly one of --out DIR or --check [DIR] (see --help)");
+    if (out) {
+        if (!args.positionals().empty()) throw Error("tables --out: unexpected argument '" + args.positionals()[0] + "'");
+        return writeTables(*args.get("--out"));
+    }
+    if (args.positionals().size() > 1) throw Error("tables --check: expected at most one directory");
+    const std::filesystem::path dir = args.positionals().empty() ? defaultTablesDir() : std::filesystem::path(args.positionals()[0]);
+    for (const std::string& line : checkTables(dir)) std::cout << line << "\n";
+    return 0;
+}
+
 }  // namespace vdbsplat::cli

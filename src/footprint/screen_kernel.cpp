@@ -1,0 +1,65 @@
+// footprint/screen_kernel.cpp — EWA widening of the exact ellipse (DESIGN §4; Zwicker
+// et al. 2001, V + V_h) and the splat's per-pixel optical depth (see screen_kernel.h).
+#include "footprint/screen_kernel.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "footprint/kernel.h"
+
+namespace vdbsplat {
+
+namespace {
+/// R_u · diag(x, y) · R_uᵀ for the orthonormal frame (u, u⊥).
+glm::dmat2 inFrame(const glm::dvec2& u, double x, double y) {
+    const glm::dvec2 v(-u.y, u.x);
+    return x * glm::outerProduct(u, u) + y * glm::outerProduct(v, v);
+}
+}  // namespace
+
+ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVariance) {
+    if (!e.isEllipse())
+        throw std::invalid_argument(std::string("makeScreenKernel: sphere is '") + sphereClassName(e.kind) +
+                                    "', not an ellipse (use the halfRayFootprint fallback)");
+    const double toSupport = Kernel::kRadius / Kernel::kSigma;  // std → support semi-axis
+    // V = R_u diag((a s_g/R)², (b s_g/R)²) R_uᵀ; V' = V + V_h I has the same eigenvectors.
+    const double widen = toSupport * toSupport * std::max(prefilterVariance, 0.0);
+    ScreenKernel k;
+    k.centre = e.centre;
+    k.u = e.u;
+    k.aGeom = e.a, k.bGeom = e.b;
+    k.a = std::sqrt(e.a * e.a + widen);
+    k.b = std::sqrt(e.b * e.b + widen);
+    k.conic = inFrame(e.u, 1.0 / (k.a * k.a), 1.0 / (k.b * k.b));
+    k.amplitude = (e.a / k.a) * (e.b / k.b);  // √(det V / det V')
+    k.alpha = e.alpha;
+    k.pullback = inFrame(e.u, e.a / k.a, e.b / k.b);
+    const glm::dvec2 v(-e.u.y, e.u.x);
+    const glm::dvec2 half(std::sqrt(k.a * k.a * e.u.x * e.u.x + k.b * k.b * v.x * v.x),
+                          std::sqrt(k.a * k.a * e.u.y * e.u.y + k.b * k.b * v.y * v.y));
+    k.bounds = {k.centre - half, k.centre + half};
+    return k;
+}
+
+SplatShader makeSplatShader(const ScreenKernel& k, const Tables& tables, double sigma, double h) {
+    SplatShader s;
+    s.row = tables.reindex.row(k.alpha);
+    s.footprint = &tables.footprint;
+    s.scale = static_cast<float>(sigma * h * k.amplitude);
+    return s;
+}
+
+double splatDeposit(const ScreenKernel& k, const SplatShader& shader, const PixelCoord& p) {
+    return shader.depositAtIndex2(static_cast<float>(k.index2(p)));
+}
+
+double splatDepositExact(const ScreenKernel& k, const SphereProjection& e, double sigma, double h,
+                         const PixelCoord& p) {
+    if (!(k.index2(p) < 1.0)) return 0.0;
+    const PixelCoord pGeom = k.centre + k.pullback * (p - k.centre);
+    const double d = exactRayDistance(e, pGeom);
+    if (!(d < 1.0)) return 0.0;
+    return sigma * h * Kernel::footprint(d * Kernel::kRadius) * k.amplitude;
+}
+
+}  // namespace vdbsplat

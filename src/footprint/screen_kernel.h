@@ -1,0 +1,83 @@
+// footprint/screen_kernel.h — the EWA-filtered screen kernel of one splat (DESIGN §4).
+// Owns: widening the exact projected ellipse (footprint/ellipse.h) by the screen
+// low-pass (Zwicker et al. 2001, EWA volume splatting: resampling filter = footprint ⊗ low-pass, with
+// V_h = kPrefilterVariance·I, footprint/prefilter.h), its conic, bounds and amplitude,
+// and the per-pixel optical depth of the splat on the table path and the exact path.
+//
+// The footprint's screen variance is the ellipse's axes scaled by s_g/R:
+//     V  = R_u · diag((a·s_g/R)², (b·s_g/R)²) · R_uᵀ,       V' = V + V_h
+// Adding a multiple of I keeps V's eigenvectors, so the support ellipse keeps the
+// axes u, u⊥ with semi-axes a' = √(a² + (R/s_g)²·V_h), b' likewise (std × R/s_g), and
+//     conic Q = R_u · diag(1/a'², 1/b'²) · R_uᵀ,   i² = (p − centre)ᵀ Q (p − centre),
+//     amplitude = √(det V / det V') = a·b / (a'·b')   (the deposit's total is unchanged,
+//     as in gsplat's antialiased mode).
+#pragma once
+#include <glm/glm.hpp>
+
+#include "camera/camera.h"
+#include "footprint/ellipse.h"
+#include "footprint/prefilter.h"
+#include "footprint/pixel_box.h"
+#include "footprint/tables.h"
+
+namespace vdbsplat {
+
+/// @brief The widened (low-pass filtered) support ellipse of one splat.
+struct ScreenKernel {
+    PixelCoord centre{0.0};    ///< the exact ellipse's centre (DESIGN §2)
+    glm::dvec2 u{1.0, 0.0};    ///< major direction (pixel space)
+    double a = 0.0, b = 0.0;   ///< support semi-axes after widening (pixels), a' and b'
+    double aGeom = 0.0, bGeom = 0.0;  ///< the exact ellipse's semi-axes before widening
+    glm::dmat2 conic{0.0};     ///< Q: i² = (p − centre)ᵀ Q (p − centre), ≤ 1 on the support
+    double amplitude = 0.0;    ///< √(det V / det(V + V_h)) ∈ (0, 1]
+    double alpha = 0.0;        ///< half cone angle of the sphere (for the reindex row)
+    PixelBox bounds;           ///< exact bounding box of the support ellipse
+    /// S: maps p − centre on the widened support to the geometric ellipse,
+    /// S = R_u diag(a/a', b/b') R_uᵀ (used by the exact path).
+    glm::dmat2 pullback{1.0};
+
+    /// @brief i² at pixel coordinate @p p.
+    double index2(const PixelCoord& p) const {
+        const glm::dvec2 x = p - centre;
+        return glm::dot(x, conic * x);
+    }
+};
+
+/// @brief The EWA screen kernel of the Ellipse @p e with low-pass variance
+/// @p prefilterVariance (px²; 0 gives the unfiltered exact ellipse, amplitude 1).
+/// @throw std::invalid_argument when @p e is not an Ellipse (see projectSphere's fallback).
+ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVariance = kPrefilterVariance);
+
+/// @brief Per-pixel optical depth of one splat on the TABLE path, prepared once per splat:
+///     τ(p) = σ_k · h · F(d) · amplitude,   d² = reindex(i², α) (2D table), F from the 1D table.
+/// Holds pointers into @p tables, which must outlive it.
+struct SplatShader {
+    ReindexTable::Row row;
+    const FootprintTable* footprint = nullptr;
+    float scale = 0.0f;  ///< σ_k · h · amplitude
+
+    /// @brief τ at squared index @p i2 (0 for i2 ≥ 1).
+    float depositAtIndex2(float i2) const {
+        if (!(i2 < 1.0f)) return 0.0f;
+        return scale * footprint->lookupD2(row.d2(i2));
+    }
+};
+
+/// @brief The table-path shader of @p k for a voxel of extinction @p sigma (per world
+/// unit) and size @p h (world units).
+SplatShader makeSplatShader(const ScreenKernel& k, const Tables& tables, double sigma, double h);
+
+/// @brief τ at pixel coordinate @p p on the table path (slow convenience: index2 + shader).
+double splatDeposit(const ScreenKernel& k, const SplatShader& shader, const PixelCoord& p);
+
+/// @brief τ at @p p on the EXACT path. "Exact" for the widened kernel means: pull p back
+/// to the unwidened geometric ellipse, p' = centre + S·(p − centre) (same unit-disk
+/// coordinates), and use the exact ray–centre distance of p' instead of the affine index
+/// and the reindex table: τ = σ·h·Kernel::footprint(R·exactRayDistance(e, p'))·amplitude.
+/// Without widening (V_h = 0) this is the exact per-pixel footprint of the sphere; it
+/// differs from the table path only by the affine-index approximation off-axis and the
+/// tables' interpolation error (DESIGN §3), which is what it is there to measure.
+double splatDepositExact(const ScreenKernel& k, const SphereProjection& e, double sigma, double h,
+                         const PixelCoord& p);
+
+}  // namespace vdbsplat

@@ -1,0 +1,83 @@
+// pointfilter/point_filter.h — the circular pixel filter w of a minified voxel (DESIGN §4).
+// Owns: the point's filter variance, its total optical depth (the energy rule that
+// must equal the splat's summed deposit at the threshold), the 1D Gaussian table
+// indexed by r²/V, and the per-point rasterization into at most 7×7 pixels.
+//
+// For a point the EWA resampling filter (Zwicker et al. 2001) is the voxel's
+// projected footprint convolved with the low-pass, both ≈ Gaussian:
+//     V_point = kPrefilterVariance + (s_g · h·f/z)²            [px²]
+// — exactly the variance of the widened splat kernel of the same voxel on-axis
+// (footprint/screen_kernel.h), so the two converge at the threshold.
+// w is truncated at r_s = min(3·√V_point, 3.5 px) (≤ 7×7 pixel centres) and
+// renormalised so that its DISCRETE sum over the pixel centres is exactly 1: then
+// the point's total deposit is exactly pointDepositTotal(), whatever its sub-pixel
+// position (the continuous ∫w = 1 would lose ≈ 1.1% to the 3σ truncation).
+#pragma once
+#include <array>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "camera/camera.h"
+
+namespace vdbsplat {
+
+inline constexpr double kPointSupportSigmas = 3.0;  ///< truncation of w in standard deviations
+inline constexpr double kPointMaxRadiusPx = 3.5;    ///< r_s cap: at most 7 pixel centres per axis
+inline constexpr int kPointMaxSide = 7;             ///< 2·kPointMaxRadiusPx
+
+/// @brief V_point = kPrefilterVariance + (s_g·@p projectedSpacingPx)² in px², where the
+/// projected voxel spacing is h·f/z pixels (DESIGN §4).
+double pointFilterVariance(double projectedSpacingPx);
+
+/// @brief The point's total optical depth summed over pixels (DESIGN §4):
+///     σ · M · (f/z)² · (D/z),   M = h³ (the kernel's volume integral in world units).
+/// M·(f/z)² = h·(h·f/z)²: a length times the projected voxel area in px². The factor
+/// D/z = 1/cosθ is the exact screen-space total of a small kernel off-axis (pixels
+/// subtend dΩ = cos³θ/f² there); DESIGN §4's σ·M·(f/z)² is its on-axis value. With it the
+/// energy test holds off-axis too (tests/pointfilter). Returns 0 for z ≤ 0.
+/// @param sigma extinction per world unit; @param h voxel size (world);
+/// @param f focal length (px); @param c view-space voxel centre.
+double pointDepositTotal(double sigma, double h, double f, const ViewPoint& c);
+
+/// @brief exp(−x/2) tabulated for x = r²/V ∈ [0, kPointSupportSigmas²] (linear lookups).
+class PointFilterTable {
+public:
+    static constexpr int kIntervals = 1024;
+    static constexpr double kMaxX = kPointSupportSigmas * kPointSupportSigmas;
+
+    PointFilterTable();  ///< builds the table (deterministic, in memory; it is not a kernel table)
+
+    /// @brief The unnormalised Gaussian weight at @p x = r²/V; 0 for x ≥ kMaxX or NaN.
+    float weight(float x) const {
+        if (!(x < kMaxXf)) return 0.0f;
+        const float t = (x > 0.0f ? x : 0.0f) * scale_;
+        int k = static_cast<int>(t);
+        if (k > kIntervals - 1) k = kIntervals - 1;
+        const float w = t - static_cast<float>(k);
+        return v_[k] + w * (v_[k + 1] - v_[k]);
+    }
+    /// @brief Max |weight − exp(−x/2)| over 16 samples per interval.
+    double maxAbsError() const;
+
+private:
+    static constexpr float kMaxXf = static_cast<float>(kMaxX);
+    std::vector<float> v_;
+    float scale_ = 0.0f;
+};
+
+/// @brief The weights of one point: pixel (x0 + ix, y0 + iy) gets w[iy·nx + ix]; they sum
+/// to 1 (up to float rounding). Pixels may lie outside the image: the renderer skips them
+/// (energy leaving the screen is lost, never piled onto the border).
+struct PointFootprint {
+    int x0 = 0, y0 = 0, nx = 0, ny = 0;
+    std::array<float, kPointMaxSide * kPointMaxSide> w{};
+    float at(int ix, int iy) const { return w[iy * nx + ix]; }
+};
+
+/// @brief Rasterizes w for a point projected at pixel coordinate @p x with filter variance
+/// @p variance (px², from pointFilterVariance): the pixels whose centres lie strictly
+/// within r_s = min(3√V, 3.5) of @p x, weights exp(−r²/2V) from @p table, renormalised
+/// to sum to 1. A non-finite @p x gives nx = ny = 0.
+PointFootprint rasterizePoint(const PointFilterTable& table, const PixelCoord& x, double variance);
+
+}  // namespace vdbsplat
