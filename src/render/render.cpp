@@ -3,6 +3,8 @@
 
 #include <chrono>
 
+#include "footprint/tables.h"
+#include "render/hybrid.h"
 #include "render/reference.h"
 #include "util/error.h"
 
@@ -34,7 +36,13 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     Image image;
     switch (settings.mode) {
         case RenderMode::Reference: image = renderReference(volume, table, camera, settings.spp, stats); break;
-        default: throw Error("--mode: '" + toString(settings.mode) + "' is not implemented yet");
+        case RenderMode::Hybrid:
+        case RenderMode::Splat:
+        case RenderMode::Point: {
+            const Tables tables = loadOrBuildTables();
+            image = renderForward(volume, table, camera, tables, settings, stats);
+            break;
+        }
     }
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return image;

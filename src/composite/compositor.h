@@ -1,0 +1,73 @@
+// composite/compositor.h — the one EWA-filtered, front-to-back compositor (DESIGN §4, §5).
+// Owns: the frame (premultiplied colour and transmittance per pixel), binning a
+// window's primitives to 16×16 screen tiles with a (slab, kind, depth, index)
+// key, and compositing every tile's list independently and in parallel:
+//   - points of one slab are summed into a slab buffer (optical depth and
+//     σ-weighted colour) and composited when the slab ends, so side-by-side
+//     points never occlude each other;
+//   - splats are composited one by one ("over") after the points of their slab;
+//   - α = 1 − exp(−τ), C += T·α·c, T *= 1 − α;
+//   - a pixel whose T < ε takes no more work; a tile whose pixels all have
+//     T < ε takes no more primitives, and blocks hidden behind such tiles are
+//     never streamed (hidden()).
+// The order inside a tile is a total order independent of threads, so the image
+// does not depend on the thread count.
+#pragma once
+#include <vector>
+
+#include "composite/primitive.h"
+#include "footprint/ellipse.h"
+#include "footprint/tables.h"
+#include "image/image.h"
+#include "pointfilter/point_filter.h"
+
+namespace vdbsplat {
+
+inline constexpr int kTileSize = 16;
+/// Transmittance below which a pixel is finished (early termination).
+inline constexpr float kTransmittanceEpsilon = 1e-4f;
+
+/// @brief What the exact and near-eye paths need to recompute a kernel per tile.
+struct ExactContext {
+    const Camera* camera = nullptr;
+    double voxelSize = 1.0;
+};
+
+class TileCompositor {
+public:
+    TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact);
+
+    /// @brief Composites @p prims (one depth window, any order) behind everything before.
+    /// @return the number of primitives skipped because every tile they touch is opaque.
+    uint64_t composite(const std::vector<Primitive>& prims, double& binSeconds, double& compositeSeconds);
+
+    /// @brief True if every pixel of the inclusive rectangle is already opaque (T < ε).
+    bool hidden(int x0, int y0, int x1, int y1) const;
+
+    /// @brief The image so far: premultiplied colour, alpha = 1 − T.
+    Image image() const;
+
+private:
+    struct Entry {
+        uint64_t key;    // slab (relative) · kind · depth bits
+        uint32_t index;  // primitive index: the tie-break
+        bool operator<(const Entry& o) const { return key != o.key ? key < o.key : index < o.index; }
+    };
+    struct SlabBuffer;
+    void compositeTile(int tile, std::vector<Entry>& entries, const std::vector<Primitive>& prims);
+    void drawPoint(const Primitive& p, int tx0, int ty0, int tx1, int ty1, SlabBuffer& slab);
+    void drawSplat(const Primitive& p, int tx0, int ty0, int tx1, int ty1);
+    void drawExact(const Primitive& p, int tx0, int ty0, int tx1, int ty1);
+    void over(size_t pixel, float tau, const glm::vec3& color);
+
+    int width_, height_, tilesX_, tilesY_;
+    const Tables& tables_;
+    ExactContext exact_;
+    PointFilterTable pointFilter_;
+    std::vector<glm::vec3> color_;        // premultiplied radiance
+    std::vector<float> transmittance_;
+    std::vector<int> liveCount_;          // per tile: pixels with T ≥ ε
+    std::vector<std::vector<Entry>> bins_;
+};
+
+}  // namespace vdbsplat

@@ -1,0 +1,42 @@
+// composite/primitive.h — the projected primitives the compositor consumes.
+// Owns: Primitive, the one record per voxel that leaves the projection stage
+// (render/project.h) and enters the tile compositor (composite/compositor.h):
+// a filtered point (DESIGN §4, circular pixel filter w), an EWA splat (exact
+// ellipse widened by the low-pass, (i, α) reindex + footprint table), or a
+// near-eye kernel drawn with the exact half-ray integral (ellipse.h fallback).
+#pragma once
+#include <cstdint>
+#include <glm/glm.hpp>
+
+#include "footprint/pixel_box.h"
+#include "footprint/screen_kernel.h"
+
+namespace vdbsplat {
+
+enum class PrimitiveKind : uint8_t {
+    Culled = 0,    ///< off screen, behind the eye, or empty: draws nothing
+    Point = 1,     ///< minified voxel: w(p − centre) with variance `variance`, total optical depth `total`
+    Splat = 2,     ///< magnified voxel, table path: conic + SplatShader
+    SplatExact = 3,///< magnified voxel, --footprint exact: recomputed per tile from viewPos
+    NearEye = 4,   ///< kernel containing the eye or straddling the eye plane: exact half-ray integral
+};
+
+struct Primitive {
+    PrimitiveKind kind = PrimitiveKind::Culled;
+    int64_t slab = 0;           ///< depth slab (points of one slab are summed before compositing)
+    float depth = 0.f;          ///< radial distance of the voxel centre (world units): the order
+    PixelRange range;           ///< the image pixels it may touch (clamped)
+    glm::vec3 color{0.f};       ///< emitted colour (already tinted for --show-primitives)
+    glm::vec2 centre{0.f};      ///< point position / ellipse centre (pixels)
+    // Point
+    float variance = 0.f;       ///< V_point, px²
+    float total = 0.f;          ///< Σ_pixels τ (DESIGN §4 energy rule)
+    // Splat (table path)
+    glm::vec3 conic{0.f};       ///< Q as (Qxx, Qxy, Qyy): i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²
+    SplatShader shader;
+    // SplatExact / NearEye (recomputed from these per tile; they are rare or a diagnostic)
+    glm::vec3 viewPos{0.f};
+    float sigma = 0.f;          ///< extinction per voxel length
+};
+
+}  // namespace vdbsplat

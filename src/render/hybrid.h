@@ -1,0 +1,19 @@
+// render/hybrid.h — the forward-resampling modes: hybrid, splat-only, point-only.
+// Owns: the pipeline grid → voxel stream (volume/stream.h) → projected
+// primitives (render/project.h) → tile compositor (composite/compositor.h) →
+// image, window by window, front to back (Yuan et al. 2003 with the EWA filter).
+#pragma once
+#include "camera/camera.h"
+#include "footprint/tables.h"
+#include "image/image.h"
+#include "render/settings.h"
+#include "volume/grid.h"
+#include "volume/transfer_function.h"
+
+namespace vdbsplat {
+
+/// @brief Renders @p volume in settings.mode (Hybrid, Splat or Point).
+Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
+                    const Tables& tables, const RenderSettings& settings, RenderStats& stats);
+
+}  // namespace vdbsplat

@@ -1,0 +1,35 @@
+// render/project.h — the projection stage: classified voxels → projected primitives.
+// Owns: the point/splat decision (projected voxel spacing h·f/z against the
+// threshold τ, DESIGN §4), and building each primitive's screen kernel: the
+// filtered point (pointfilter/), the EWA splat (footprint/screen_kernel.h), or
+// the near-eye fallback (footprint/ellipse.h). Runs in parallel; primitive i
+// always comes from voxel i, so the order stays deterministic.
+#pragma once
+#include <vector>
+
+#include "camera/camera.h"
+#include "composite/primitive.h"
+#include "footprint/tables.h"
+#include "render/settings.h"
+#include "volume/stream.h"
+
+namespace vdbsplat {
+
+struct ProjectionContext {
+    const Camera& camera;
+    const Tables& tables;
+    double voxelSize;     ///< h (world units)
+    double slabLength;    ///< world length of one slab
+    RenderMode mode;      ///< Hybrid, Splat or Point
+    double threshold;     ///< τ in pixels
+    FootprintPath footprint;
+    bool showPrimitives;
+};
+
+/// @brief Projects every voxel of @p batch into @p prims (resized to the batch size).
+void projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, std::vector<Primitive>& prims);
+
+/// @brief Projects one voxel (view-space centre @p c, extinction per voxel length @p sigma).
+Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx);
+
+}  // namespace vdbsplat
