@@ -1,0 +1,82 @@
+// volume/generate.h — procedural test volumes (`vdbsplat generate`).
+// Owns: the sparse float grids named "density" (fog volumes, voxel size 1,
+// values in [0,1]) that the tests, demos and benchmarks render:
+//  - checkerbox:     the 3D Checker Box of Yuan et al. 2003 (every voxel active),
+//  - marschner-lobb: the Marschner–Lobb 1994 test signal (f_M = 6, α = 0.25),
+//  - sphere:         a smooth fog ball,
+//  - cloud:          thresholded fractal value noise with a requested active count.
+// Every grid is built leaf by leaf (8³) in parallel and inserted in a fixed order,
+// so the result is identical for any thread count and never densified.
+#pragma once
+#include <openvdb/openvdb.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vdbsplat {
+
+/// Checker box: cells per side (independent of --res, so the pattern scales with it).
+inline constexpr int kCheckerCellsPerSide = 10;
+/// Checker box: density of the cells whose cell-index sum is even / odd.
+inline constexpr float kCheckerDensityEven = 1.0f;
+inline constexpr float kCheckerDensityOdd = 0.3f;
+/// Marschner–Lobb parameters (the 1994 paper's standard choice).
+inline constexpr double kMarschnerLobbFM = 6.0;
+inline constexpr double kMarschnerLobbAlpha = 0.25;
+/// Upper bound on the active voxels any generator may create (about 8 GB of float leaves).
+inline constexpr uint64_t kMaxGeneratedVoxels = 2'000'000'000ull;
+/// Largest --res accepted (further limited by kMaxGeneratedVoxels).
+inline constexpr int kMaxGenerateRes = 4096;
+/// Cloud: promised accuracy of the active count, |count − N| / N, for N ≥ 1000 (measured well below).
+inline constexpr double kCloudCountTolerance = 0.02;
+/// Default sizes.
+inline constexpr int kDefaultCheckerRes = 100, kDefaultMarschnerLobbRes = 41, kDefaultSphereRes = 64;
+inline constexpr uint64_t kDefaultCloudActive = 1'000'000, kDefaultCloudSeed = 1;
+
+/// @brief What to generate; unset fields take the kind's default in validate().
+struct GenerateOptions {
+    std::string kind;               ///< checkerbox | marschner-lobb | sphere | cloud
+    std::optional<int> res;         ///< grid side in voxels (not for cloud)
+    std::optional<uint64_t> active; ///< cloud only: target active voxel count
+    std::optional<uint64_t> seed;   ///< cloud only: noise seed
+
+    /// @brief Fills in defaults and checks the combination (messages name the flag).
+    /// @throw Error for an unknown kind, a flag the kind does not use, or sizes out of bounds.
+    void validate();
+};
+
+/// @brief The names accepted as GenerateOptions::kind, in documentation order.
+const std::vector<std::string>& generatorKinds();
+
+/// @brief Generates the grid described by @p options (validated first).
+/// @throw Error as GenerateOptions::validate.
+openvdb::FloatGrid::Ptr generateVolume(GenerateOptions options);
+
+/// @brief The 3D Checker Box: res³ voxels at index (0..res-1)³, all active, kCheckerCellsPerSide
+/// cells per side; voxel (i,j,k) lies in cell (⌊10i/res⌋, ⌊10j/res⌋, ⌊10k/res⌋) and has
+/// kCheckerDensityEven when the cell indices sum to an even number, kCheckerDensityOdd otherwise.
+/// @param res side in voxels (validated by GenerateOptions)
+openvdb::FloatGrid::Ptr makeCheckerBox(int res);
+
+/// @brief The Marschner–Lobb value at a point of [-1,1]³:
+/// ρ = (1 − sin(πz/2) + α(1 + cos(2π f_M cos(π r/2)))) / (2(1 + α)), r = √(x² + y²); in [0,1].
+double marschnerLobb(double x, double y, double z);
+
+/// @brief The Marschner–Lobb signal sampled at res³ points of [-1,1]³: index i ↦ −1 + 2i/(res−1); all active.
+/// @param res samples per axis (validated by GenerateOptions)
+openvdb::FloatGrid::Ptr makeMarschnerLobb(int res);
+
+/// @brief A smooth fog ball: centre c = (res−1)/2 on each axis, radius R = (res−1)/2,
+/// density (1 − (r/R)²)² for r < R (C¹ at the rim), active exactly where the density is > 0.
+/// @param res side of the bounding cube in voxels (validated by GenerateOptions)
+openvdb::FloatGrid::Ptr makeSphere(int res);
+
+/// @brief Thresholded fractal value noise inside a soft ball, with about @p active active voxels
+/// (within kCloudCountTolerance for active ≥ 1000). Deterministic by @p seed for any thread count;
+/// memory proportional to the active voxels (the domain is visited leaf by leaf, never stored).
+/// @param active target active count (validated by GenerateOptions)
+openvdb::FloatGrid::Ptr makeCloud(uint64_t active, uint64_t seed);
+
+}  // namespace vdbsplat
