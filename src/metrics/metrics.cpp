@@ -20,8 +20,6 @@ constexpr double kC2 = 0.03 * 0.03;
 constexpr int kWindowRadius = 5;      // 11×11 window
 constexpr double kWindowSigma = 1.5;  // Gaussian σ in pixels
 
-/// The display value of one linear channel: over black, sRGB-encoded; NaN → 0.
-float display(float linear) { return std::isnan(linear) ? 0.f : linearToSrgb(linear); }
 
 bool hasNan(const glm::vec4& p) { return std::isnan(p.x) || std::isnan(p.y) || std::isnan(p.z); }
 
@@ -36,7 +34,7 @@ std::vector<double> luma(const Image& image) {
     std::vector<double> y(image.pixels.size());
     for (size_t i = 0; i < y.size(); ++i) {
         const glm::vec4& p = image.pixels[i];
-        y[i] = 0.2126 * display(p.x) + 0.7152 * display(p.y) + 0.0722 * display(p.z);
+        y[i] = 0.2126 * displayValue(p.x) + 0.7152 * displayValue(p.y) + 0.0722 * displayValue(p.z);
     }
     return y;
 }
@@ -79,6 +77,13 @@ std::vector<double> product(const std::vector<double>& a, const std::vector<doub
 
 }  // namespace
 
+double displayValue(float linear) {
+    const double v = double(linear);
+    if (std::isnan(v) || v <= 0.0) return 0.0;
+    if (v >= 1.0) return 1.0;
+    return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
 std::string sizeText(const Image& image) { return std::to_string(image.width) + "x" + std::to_string(image.height); }
 
 double psnrFromMse(double mse) {
@@ -112,7 +117,7 @@ ImageMetrics compareImages(const Image& image, const Image& reference) {
             const glm::vec4& b = reference.at(x, y);
             if (hasNan(a) || hasNan(b)) ++m.nonFinitePixels;
             for (int c = 0; c < 3; ++c) {
-                const double d = double(display(a[c])) - double(display(b[c]));
+                const double d = displayValue(a[c]) - displayValue(b[c]);
                 row += d * d;
                 m.maxAbsError = std::max(m.maxAbsError, std::abs(d));
             }

@@ -2,7 +2,7 @@
 // Owns: MSE, RMSE, PSNR, max abs error and SSIM as a library (tests, `vdbsplat
 // compare`, the benchmark). Images are compared as people see them: each
 // premultiplied linear RGB pixel is taken over black (alpha is ignored) and
-// sRGB-encoded to display values in [0, 1] (linearToSrgb clamps), then
+// sRGB-encoded to display values in [0, 1] (clamped, in double: displayValue), then
 //   MSE  = mean over pixels and R, G, B of (a − b)²,  RMSE = √MSE,
 //   PSNR = 10·log10(1 / MSE) dB (peak 1; +inf for identical display values),
 //   max abs error = max over pixels and R, G, B of |a − b|,
@@ -10,7 +10,7 @@
 //          display values: 11×11 Gaussian window (σ = 1.5), K1 = 0.01, K2 = 0.03,
 //          L = 1, evaluated at every pixel (windows truncated at the border and
 //          renormalised) and averaged.
-// NaN display values count in nonFinitePixels and are compared as black.
+// NaN channels count in nonFinitePixels and are compared as black (0); ±inf clamp.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -28,6 +28,10 @@ struct ImageMetrics {
     double ssim = 1.0;         ///< mean SSIM on luma, in [−1, 1]; 1 for identical images
     uint64_t nonFinitePixels = 0;  ///< pixels with a NaN channel in either image (compared as black)
 };
+
+/// @brief The display value of one linear channel: over black, clamped to [0, 1] and
+/// sRGB-encoded in double precision (exactly 0 at 0 and 1 at 1); NaN → 0.
+double displayValue(float linear);
 
 /// @brief PSNR in dB of a mean squared error with peak 1: 10·log10(1 / mse); +inf for mse == 0.
 double psnrFromMse(double mse);
