@@ -32,4 +32,15 @@ inline PixelRange pixelRange(const PixelBox& box, int width, int height) {
     return {first(box.lo.x, width), first(box.lo.y, height), last(box.hi.x, width), last(box.hi.y, height)};
 }
 
+/// @brief The pixels whose centres lie in @p box, not clamped to any image (coordinates
+/// are clamped to ±2³⁰ so the integer cast is always defined). For tests and for
+/// rasterizers that clip later.
+inline PixelRange pixelRange(const PixelBox& box) {
+    if (box.empty()) return {};
+    constexpr double kLim = 1 << 30;  // captured by value: std::clamp takes references
+    auto first = [kLim](double lo) { return (int)std::clamp(std::ceil(lo - 0.5), -kLim, kLim); };
+    auto last = [kLim](double hi) { return (int)std::clamp(std::floor(hi - 0.5), -kLim, kLim); };
+    return {first(box.lo.x), first(box.lo.y), last(box.hi.x), last(box.hi.y)};
+}
+
 }  // namespace vdbsplat

@@ -121,8 +121,8 @@ ParsedFile splitFile(const std::string& bytes, const std::string& name) {
     return p;
 }
 
-/// Version, kind, kernel identity, payload size and checksum; returns the float payload.
-std::vector<float> verifyCommon(const ParsedFile& p, const std::string& kind, size_t expectedValues) {
+/// Version, table kind and kernel identity: checked before anything else in the header.
+void verifyIdentity(const ParsedFile& p, const std::string& kind) {
     if (p.get("format_version") != std::to_string(kTableFormatVersion))
         p.fail("table format version " + p.get("format_version") + ", this build reads version " +
                std::to_string(kTableFormatVersion) + " (regenerate with `vdbsplat tables --out DIR`)");
@@ -133,6 +133,10 @@ std::vector<float> verifyCommon(const ParsedFile& p, const std::string& kind, si
         p.fail("table built for kernel '" + p.get("kernel") + "' (s_g " + fmt("%g", sigma) + ", R " +
                fmt("%g", radius) + "), this build uses '" + Kernel::kName + "' (s_g " +
                fmt("%g", Kernel::kSigma) + ", R " + fmt("%g", Kernel::kRadius) + ")");
+}
+
+/// Payload size and checksum; returns the float payload.
+std::vector<float> verifyPayload(const ParsedFile& p, size_t expectedValues) {
     const std::string expect = "float32le " + std::to_string(expectedValues * sizeof(float));
     if (p.get("payload") != expect) p.fail("table header says payload '" + p.get("payload") + "', expected '" + expect + "'");
     if (p.payload.size() != expectedValues * sizeof(float))
@@ -291,20 +295,22 @@ std::string serializeReindexTable(const ReindexTable& t) {
 
 FootprintTable parseFootprintTable(const std::string& bytes, const std::string& name) {
     const ParsedFile p = splitFile(bytes, name);
+    verifyIdentity(p, "footprint");
     const int n = intervalCount(p, p.number("intervals"));
     if (p.get("index") != "d2" || p.get("domain") != "0 1") p.fail("footprint table: unsupported index or domain");
-    std::vector<float> v = verifyCommon(p, "footprint", static_cast<size_t>(n) + 1);
+    std::vector<float> v = verifyPayload(p, static_cast<size_t>(n) + 1);
     return FootprintTable(std::move(v), p.number("max_abs_error"), p.number("error_bound"));
 }
 
 ReindexTable parseReindexTable(const std::string& bytes, const std::string& name) {
     const ParsedFile p = splitFile(bytes, name);
+    verifyIdentity(p, "reindex");
     const std::vector<double> n = p.numbers("intervals", 2);
     const int nI2 = intervalCount(p, n[0]), nAlpha = intervalCount(p, n[1]);
     if (p.get("domain_i2") != "0 1") p.fail("reindex table: unsupported i2 domain");
     const std::vector<double> dom = p.numbers("domain_alpha_deg", 2);
     if (dom[0] != 0.0 || !(dom[1] > 0.0 && dom[1] <= 60.0)) p.fail("reindex table: unsupported alpha domain");
-    std::vector<float> v = verifyCommon(p, "reindex", static_cast<size_t>(nI2 + 1) * (nAlpha + 1));
+    std::vector<float> v = verifyPayload(p, static_cast<size_t>(nI2 + 1) * (nAlpha + 1));
     return ReindexTable(std::move(v), nI2, nAlpha, dom[1], p.number("max_abs_error"), p.number("error_bound"));
 }
 

@@ -1,0 +1,111 @@
+// tests/footprint/screen_kernel_test.cpp — the EWA-filtered splat kernel (DESIGN §4):
+// widening keeps the total deposit, the conic and amplitude match V + V_h, the table
+// path matches the exact path on-axis, and non-ellipses are refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <stdexcept>
+
+#include "footprint/ellipse.h"
+#include "footprint/kernel.h"
+#include "footprint/screen_kernel.h"
+#include "footprint/tables.h"
+
+namespace vdbsplat {
+namespace {
+
+const Tables& tables() {
+    static const Tables t = buildTables();  // test-local cache
+    return t;
+}
+
+/// Σ over the kernel's pixels of the table-path deposit.
+double tableTotal(const ScreenKernel& k, double sigma, double h) {
+    const SplatShader shader = makeSplatShader(k, tables(), sigma, h);
+    const PixelRange r = pixelRange(k.bounds);
+    double sum = 0.0;
+    for (int y = r.y0; y <= r.y1; ++y)
+        for (int x = r.x0; x <= r.x1; ++x) sum += splatDeposit(k, shader, {x + 0.5, y + 0.5});
+    return sum;
+}
+
+SphereProjection offAxisSphere(double f) {
+    return projectSphere({1.5, -0.8, 9.0}, 0.2, f, {300.5, 200.25});
+}
+
+TEST(ScreenKernel, ConicAndAmplitudeMatchVPlusVh) {
+    const SphereProjection e = offAxisSphere(400.0);
+    ASSERT_EQ(e.kind, SphereClass::Ellipse);
+    const ScreenKernel k = makeScreenKernel(e);
+    const double s = Kernel::kSigma / Kernel::kRadius;
+    const glm::dvec2 u = e.u, v(-u.y, u.x);
+    const glm::dmat2 V = (e.a * s) * (e.a * s) * glm::outerProduct(u, u) + (e.b * s) * (e.b * s) * glm::outerProduct(v, v);
+    const glm::dmat2 Vw = V + glm::dmat2(kPrefilterVariance);
+    EXPECT_NEAR(k.amplitude, std::sqrt(glm::determinant(V) / glm::determinant(Vw)), 1e-12);
+    const glm::dmat2 Q = glm::inverse(Vw) * (s * s);  // support = std × R/s_g
+    for (int c = 0; c < 2; ++c)
+        for (int r = 0; r < 2; ++r) EXPECT_NEAR(k.conic[c][r], Q[c][r], 1e-12 * std::abs(Q[0][0]));
+    EXPECT_NEAR(k.index2(k.centre + k.a * u), 1.0, 1e-12);
+    EXPECT_NEAR(k.index2(k.centre + k.b * v), 1.0, 1e-12);
+    EXPECT_GT(k.a, e.a);
+    EXPECT_GT(k.b, e.b);
+}
+
+TEST(ScreenKernel, NoPrefilterIsTheExactEllipse) {
+    const SphereProjection e = offAxisSphere(400.0);
+    const ScreenKernel k = makeScreenKernel(e, 0.0);
+    EXPECT_DOUBLE_EQ(k.amplitude, 1.0);
+    for (const glm::dvec2 d : {glm::dvec2(3.0, 1.0), glm::dvec2(-2.0, 4.0), glm::dvec2(0.5, -7.0)})
+        EXPECT_NEAR(k.index2(e.centre + d), e.index2(e.centre + d), 1e-12);
+}
+
+TEST(ScreenKernel, EwaTotalEqualsUnfilteredTotal) {
+    for (double f : {150.0, 400.0, 1500.0}) {  // semi-axes ≈ 3.4, 9, 34 px
+        const SphereProjection e = offAxisSphere(f);
+        const double filtered = tableTotal(makeScreenKernel(e), 2.0, 0.1);
+        const double unfiltered = tableTotal(makeScreenKernel(e, 0.0), 2.0, 0.1);
+        std::printf("f %6.0f: a %.2f px, EWA total / unfiltered total = %.6f\n", f, e.a, filtered / unfiltered);
+        EXPECT_NEAR(filtered / unfiltered, 1.0, 5e-3) << "f " << f;
+    }
+}
+
+TEST(ScreenKernel, BoundsContainTheSupport) {
+    const ScreenKernel k = makeScreenKernel(offAxisSphere(400.0));
+    for (int n = 0; n < 360; ++n) {
+        const double t = n * std::numbers::pi / 180.0;
+        const glm::dvec2 p = k.centre + k.a * std::cos(t) * k.u + k.b * std::sin(t) * glm::dvec2(-k.u.y, k.u.x);
+        EXPECT_GE(p.x, k.bounds.lo.x - 1e-9);
+        EXPECT_LE(p.x, k.bounds.hi.x + 1e-9);
+        EXPECT_GE(p.y, k.bounds.lo.y - 1e-9);
+        EXPECT_LE(p.y, k.bounds.hi.y + 1e-9);
+    }
+}
+
+TEST(ScreenKernel, TablePathMatchesExactPathOnAxis) {
+    for (double alphaDeg : {1.0, 10.0, 40.0}) {
+        const double D = 6.0, r = D * std::sin(alphaDeg * std::numbers::pi / 180.0);
+        const SphereProjection e = projectSphere({0.0, 0.0, D}, r, 30.0 / std::tan(alphaDeg * std::numbers::pi / 180.0), {50.0, 50.0});
+        const ScreenKernel k = makeScreenKernel(e, 0.0);
+        const SplatShader shader = makeSplatShader(k, tables(), 1.0, 1.0);
+        double worst = 0.0;
+        const PixelRange range = pixelRange(k.bounds);
+        for (int y = range.y0; y <= range.y1; ++y)
+            for (int x = range.x0; x <= range.x1; ++x) {
+                const PixelCoord p(x + 0.5, y + 0.5);
+                if (k.index2(p) > 0.999) continue;  // the rim: in/out differs by rounding
+                worst = std::max(worst, std::abs(splatDeposit(k, shader, p) - splatDepositExact(k, e, 1.0, 1.0, p)));
+            }
+        EXPECT_LT(worst, 2e-4 * Kernel::footprint(0.0)) << "alpha " << alphaDeg;
+    }
+}
+
+TEST(ScreenKernel, NonEllipsesAreRefused) {
+    EXPECT_THROW(makeScreenKernel(projectSphere({0.0, 0.0, 0.5}, 1.0, 100.0, {0.0, 0.0})), std::invalid_argument);
+    EXPECT_THROW(makeScreenKernel(projectSphere({3.0, 0.0, 0.5}, 1.0, 100.0, {0.0, 0.0})), std::invalid_argument);
+    EXPECT_THROW(makeScreenKernel(projectSphere({0.0, 0.0, -5.0}, 1.0, 100.0, {0.0, 0.0})), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace vdbsplat

@@ -1,0 +1,162 @@
+// tests/pointfilter/point_filter_test.cpp — the point's circular pixel filter (DESIGN §4)
+// and THE energy test of issue 3: at the threshold (h·f/z = 1 px) the splat's summed
+// deposit equals the point's summed deposit for the same voxel within 1%.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "footprint/ellipse.h"
+#include "footprint/kernel.h"
+#include "footprint/prefilter.h"
+#include "footprint/screen_kernel.h"
+#include "footprint/tables.h"
+#include "pointfilter/point_filter.h"
+
+namespace vdbsplat {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+double weightSum(const PointFootprint& fp) {
+    double s = 0.0;
+    for (int k = 0; k < fp.nx * fp.ny; ++k) s += fp.w[k];
+    return s;
+}
+
+TEST(PointFilter, VarianceIsPrefilterPlusProjectedFootprint) {
+    EXPECT_DOUBLE_EQ(pointFilterVariance(0.0), kPrefilterVariance);
+    EXPECT_NEAR(pointFilterVariance(1.0), kPrefilterVariance + 0.65 * 0.65, 1e-15);
+    EXPECT_NEAR(pointFilterVariance(0.5), kPrefilterVariance + 0.325 * 0.325, 1e-15);
+}
+
+TEST(PointFilter, TableMatchesTheGaussian) {
+    const PointFilterTable t;
+    EXPECT_LT(t.maxAbsError(), 5e-6);  // Δ²/8 · max|(e^{−x/2})″| with Δ = 9/1024
+    EXPECT_FLOAT_EQ(t.weight(0.0f), 1.0f);
+    EXPECT_EQ(t.weight(9.0f), 0.0f);
+    EXPECT_EQ(t.weight(std::nanf("")), 0.0f);
+}
+
+TEST(PointFilter, WeightsSumToOneWithinSevenBySeven) {
+    const PointFilterTable t;
+    for (double spacing : {0.0, 0.3, 0.7, 1.0, 1.5, 3.0})
+        for (double fx = 0.0; fx < 1.0; fx += 0.125)
+            for (double fy = 0.0; fy < 1.0; fy += 0.25) {
+                const PointFootprint fp = rasterizePoint(t, {100.0 + fx, 37.0 + fy}, pointFilterVariance(spacing));
+                EXPECT_LE(fp.nx, kPointMaxSide);
+                EXPECT_LE(fp.ny, kPointMaxSide);
+                EXPECT_GE(fp.nx, 5);  // V = 1: centres strictly within 3 px
+                EXPECT_NEAR(weightSum(fp), 1.0, 1e-6);
+                for (int k = 0; k < fp.nx * fp.ny; ++k) EXPECT_GE(fp.w[k], 0.0f);
+            }
+}
+
+TEST(PointFilter, ShapeIsTheTruncatedGaussianAndSymmetric) {
+    const PointFilterTable t;
+    const double V = pointFilterVariance(1.0);
+    const PointFootprint fp = rasterizePoint(t, {10.5, 20.5}, V);  // at a pixel centre
+    ASSERT_EQ(fp.nx, 7);
+    ASSERT_EQ(fp.ny, 7);
+    EXPECT_EQ(fp.x0, 7);
+    EXPECT_EQ(fp.y0, 17);
+    const float c = fp.at(3, 3);
+    for (int iy = 0; iy < 7; ++iy)
+        for (int ix = 0; ix < 7; ++ix) {
+            EXPECT_FLOAT_EQ(fp.at(ix, iy), fp.at(6 - ix, iy));
+            EXPECT_FLOAT_EQ(fp.at(ix, iy), fp.at(iy, ix));
+            const double r2 = (ix - 3) * (ix - 3) + (iy - 3) * (iy - 3);
+            const double rs = std::min(3.0 * std::sqrt(V), kPointMaxRadiusPx);
+            const double expected = r2 < rs * rs ? std::exp(-r2 / (2.0 * V)) : 0.0;
+            EXPECT_NEAR(fp.at(ix, iy) / c, expected, 1e-5);
+        }
+}
+
+TEST(PointFilter, DepositTotalIsSigmaMTimesProjectedArea) {
+    const double sigma = 3.0, h = 0.02, f = 500.0;
+    // On-axis: σ·M·(f/z)² = σ·h·(h f/z)².
+    EXPECT_NEAR(pointDepositTotal(sigma, h, f, {0.0, 0.0, 10.0}), sigma * h * 1.0, 1e-15);
+    // Off-axis by θ: the exact screen total grows by D/z = 1/cos θ.
+    const ViewPoint c{10.0 * std::tan(30.0 * kDeg), 0.0, 10.0};
+    EXPECT_NEAR(pointDepositTotal(sigma, h, f, c), sigma * h / std::cos(30.0 * kDeg), 1e-12);
+    EXPECT_EQ(pointDepositTotal(sigma, h, f, {0.0, 0.0, -1.0}), 0.0);
+}
+
+struct EnergyCase {
+    double thetaDeg, phiDeg, subX, subY;
+};
+
+/// Summed splat deposit (table path and exact path) and point deposit of one voxel.
+struct Energy {
+    double splatTable = 0.0, splatExact = 0.0, point = 0.0, maxPixelDiff = 0.0, peak = 0.0;
+};
+
+Energy energyAt(const Tables& tables, const PointFilterTable& pft, const EnergyCase& ec, double spacingPx) {
+    const double f = 500.0, sigma = 2.0, z = 10.0, h = spacingPx * z / f;
+    const PixelCoord pp(200.0 + ec.subX, 200.0 + ec.subY);
+    const double t = std::tan(ec.thetaDeg * kDeg);
+    const ViewPoint c{z * t * std::cos(ec.phiDeg * kDeg), z * t * std::sin(ec.phiDeg * kDeg), z};
+    const SphereProjection e = projectSphere(c, Kernel::kRadius * h, f, pp);
+    const ScreenKernel k = makeScreenKernel(e);
+    const SplatShader shader = makeSplatShader(k, tables, sigma, h);
+    Energy out;
+    // Point: projected at the projection of c (what the renderer does), weights × total.
+    const PixelCoord proj(pp.x + f * c.x / c.z, pp.y - f * c.y / c.z);
+    const double total = pointDepositTotal(sigma, h, f, c);
+    const PointFootprint fp = rasterizePoint(pft, proj, pointFilterVariance(spacingPx));
+    for (int k2 = 0; k2 < fp.nx * fp.ny; ++k2) out.point += total * fp.w[k2];
+    const PixelRange r = pixelRange(k.bounds);
+    for (int y = r.y0; y <= r.y1; ++y)
+        for (int x = r.x0; x <= r.x1; ++x) {
+            const PixelCoord p(x + 0.5, y + 0.5);
+            const double s = splatDeposit(k, shader, p);
+            out.splatTable += s;
+            out.splatExact += splatDepositExact(k, e, sigma, h, p);
+            double pt = 0.0;
+            const int ix = x - fp.x0, iy = y - fp.y0;
+            if (ix >= 0 && iy >= 0 && ix < fp.nx && iy < fp.ny) pt = total * fp.at(ix, iy);
+            out.maxPixelDiff = std::max(out.maxPixelDiff, std::abs(s - pt));
+            out.peak = std::max(out.peak, s);
+        }
+    return out;
+}
+
+TEST(PointFilterEnergy, SplatEqualsPointAtTheThresholdWithinOnePercent) {
+    const Tables tables = buildTables();
+    const PointFilterTable pft;
+    const EnergyCase cases[] = {{0.0, 0.0, 0.0, 0.0},   {0.0, 0.0, 0.37, 0.81}, {0.0, 0.0, 0.5, 0.5},
+                                {10.0, 30.0, 0.2, 0.6}, {20.0, 120.0, 0.9, 0.1}, {35.0, 250.0, 0.45, 0.3}};
+    std::printf("energy at the threshold (h f/z = 1 px): splat/point (table, exact), max pixel diff / peak\n");
+    double worst = 0.0;
+    for (const EnergyCase& ec : cases) {
+        const Energy e = energyAt(tables, pft, ec, 1.0);
+        const double ratio = e.splatTable / e.point, ratioExact = e.splatExact / e.point;
+        std::printf("  theta %4.1f° phi %5.1f° sub (%.2f, %.2f): %.5f  %.5f  %.4f\n", ec.thetaDeg, ec.phiDeg, ec.subX,
+                    ec.subY, ratio, ratioExact, e.maxPixelDiff / e.peak);
+        worst = std::max({worst, std::abs(ratio - 1.0), std::abs(ratioExact - 1.0)});
+        EXPECT_NEAR(ratio, 1.0, 0.01) << "theta " << ec.thetaDeg;
+        EXPECT_NEAR(ratioExact, 1.0, 0.01) << "theta " << ec.thetaDeg;
+        EXPECT_LT(e.maxPixelDiff / e.peak, 0.1) << "the two kernels converge at the threshold";
+    }
+    RecordProperty("energy_worst_relative_deviation", testing::PrintToString(worst));
+}
+
+TEST(PointFilterEnergy, EnergyMatchesAcrossScales) {
+    // Away from the threshold the two paths still carry the same total (zoom does not pop).
+    const Tables tables = buildTables();
+    const PointFilterTable pft;
+    for (double spacing : {0.5, 0.8, 1.25, 2.0}) {
+        const Energy e = energyAt(tables, pft, {15.0, 60.0, 0.3, 0.7}, spacing);
+        EXPECT_NEAR(e.splatTable / e.point, 1.0, 0.01) << "spacing " << spacing;
+    }
+}
+
+TEST(PointFilter, NonFiniteInputGivesNoPixels) {
+    const PointFilterTable t;
+    EXPECT_EQ(rasterizePoint(t, {std::nan(""), 1.0}, 1.5).nx, 0);
+    EXPECT_EQ(rasterizePoint(t, {1e300, 1.0}, 1.5).nx, 0);
+}
+
+}  // namespace
+}  // namespace vdbsplat
