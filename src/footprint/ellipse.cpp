@@ -116,6 +116,13 @@ double exactRayDistance(const SphereProjection& s, const PixelCoord& p) {
     return glm::length(glm::cross(s.c, v)) / (glm::length(v) * s.r);
 }
 
+double exactRayDistance2(const SphereProjection& s, const PixelCoord& p) {
+    if (!(s.r > 0.0)) return std::numeric_limits<double>::infinity();
+    const glm::dvec3 v = pixelRay(s, p);
+    const glm::dvec3 w = glm::cross(s.c, v);
+    return glm::dot(w, w) / (glm::dot(v, v) * s.r * s.r);
+}
+
 double halfRayFootprint(const SphereProjection& s, const PixelCoord& p) {
     if (!(s.r > 0.0) || s.kind == SphereClass::Behind) return 0.0;
     const glm::dvec3 v = glm::normalize(pixelRay(s, p));

@@ -3,6 +3,7 @@
 #include "footprint/screen_kernel.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "footprint/kernel.h"
@@ -53,13 +54,16 @@ double splatDeposit(const ScreenKernel& k, const SplatShader& shader, const Pixe
     return shader.depositAtIndex2(static_cast<float>(k.index2(p)));
 }
 
+double exactIndexD2(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& p) {
+    if (!(k.index2(p) < 1.0)) return std::numeric_limits<double>::infinity();
+    return exactRayDistance2(e, k.centre + k.pullback * (p - k.centre));
+}
+
 double splatDepositExact(const ScreenKernel& k, const SphereProjection& e, double sigma, double h,
                          const PixelCoord& p) {
-    if (!(k.index2(p) < 1.0)) return 0.0;
-    const PixelCoord pGeom = k.centre + k.pullback * (p - k.centre);
-    const double d = exactRayDistance(e, pGeom);
-    if (!(d < 1.0)) return 0.0;
-    return sigma * h * Kernel::footprint(d * Kernel::kRadius) * k.amplitude;
+    const double d2 = exactIndexD2(k, e, p);
+    if (!(d2 < 1.0)) return 0.0;
+    return sigma * h * Kernel::footprint(std::sqrt(d2) * Kernel::kRadius) * k.amplitude;
 }
 
 }  // namespace vdbsplat

@@ -61,6 +61,8 @@ struct SplatShader {
         if (!(i2 < 1.0f)) return 0.0f;
         return scale * footprint->lookupD2(row.d2(i2));
     }
+    /// @brief τ at squared normalised distance @p d2 (from exactIndexD2; 0 for d2 ≥ 1).
+    float depositAtD2(float d2) const { return scale * footprint->lookupD2(d2); }
 };
 
 /// @brief The table-path shader of @p k for a voxel of extinction @p sigma (per world
@@ -70,6 +72,14 @@ SplatShader makeSplatShader(const ScreenKernel& k, const Tables& tables, double 
 /// @brief τ at pixel coordinate @p p on the table path (slow convenience: index2 + shader).
 double splatDeposit(const ScreenKernel& k, const SplatShader& shader, const PixelCoord& p);
 
+/// @brief The exact d² for pixel @p p of the widened kernel @p k of sphere @p e: the pixel
+/// pulled back to the geometric ellipse, p' = centre + S·(p − centre), then
+/// exactRayDistance2(e, p'). Returns +infinity outside the support (i² ≥ 1). With
+/// SplatShader::depositAtD2 this is the fast exact path: it removes the affine-index
+/// error off-axis (which grows like tanθ·tanα, see docs/footprint.md) at about the cost
+/// of the table path.
+double exactIndexD2(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& p);
+
 /// @brief τ at @p p on the EXACT path. "Exact" for the widened kernel means: pull p back
 /// to the unwidened geometric ellipse, p' = centre + S·(p − centre) (same unit-disk
 /// coordinates), and use the exact ray–centre distance of p' instead of the affine index
@@ -77,6 +87,7 @@ double splatDeposit(const ScreenKernel& k, const SplatShader& shader, const Pixe
 /// Without widening (V_h = 0) this is the exact per-pixel footprint of the sphere; it
 /// differs from the table path only by the affine-index approximation off-axis and the
 /// tables' interpolation error (DESIGN §3), which is what it is there to measure.
+/// Uses the closed form Kernel::footprint (erf): a measuring tool, not for the hot loop.
 double splatDepositExact(const ScreenKernel& k, const SphereProjection& e, double sigma, double h,
                          const PixelCoord& p);
 

@@ -101,6 +101,30 @@ TEST(ScreenKernel, TablePathMatchesExactPathOnAxis) {
     }
 }
 
+TEST(ScreenKernel, FastExactPathMatchesClosedFormExactPathOffAxis) {
+    const SphereProjection e = projectSphere({2.5, 1.0, 6.0}, 1.2, 300.0, {10.0, 20.0});  // θ ≈ 24°, α ≈ 10°
+    ASSERT_EQ(e.kind, SphereClass::Ellipse);
+    const ScreenKernel k = makeScreenKernel(e);
+    const SplatShader shader = makeSplatShader(k, tables(), 1.0, 1.0);
+    double worstFast = 0.0, worstTable = 0.0;
+    const PixelRange range = pixelRange(k.bounds);
+    for (int y = range.y0; y <= range.y1; ++y)
+        for (int x = range.x0; x <= range.x1; ++x) {
+            const PixelCoord p(x + 0.5, y + 0.5);
+            const double exact = splatDepositExact(k, e, 1.0, 1.0, p);
+            const double d2 = exactIndexD2(k, e, p);
+            const double fast = d2 < 1.0 ? shader.depositAtD2(static_cast<float>(d2)) : 0.0;
+            worstFast = std::max(worstFast, std::abs(fast - exact));
+            worstTable = std::max(worstTable, std::abs(splatDeposit(k, shader, p) - exact));
+        }
+    const double peak = Kernel::footprint(0.0) * k.amplitude;
+    std::printf("off-axis splat (theta %.1f°, alpha %.1f°): max |table − exact| / peak = %.4f, "
+                "max |fast exact − exact| / peak = %.2e\n",
+                e.theta * 180.0 / std::numbers::pi, e.alpha * 180.0 / std::numbers::pi, worstTable / peak, worstFast / peak);
+    EXPECT_LT(worstFast, 2e-4 * peak);
+    EXPECT_GT(worstTable, 10.0 * worstFast);  // the affine index is the dominant error off-axis
+}
+
 TEST(ScreenKernel, NonEllipsesAreRefused) {
     EXPECT_THROW(makeScreenKernel(projectSphere({0.0, 0.0, 0.5}, 1.0, 100.0, {0.0, 0.0})), std::invalid_argument);
     EXPECT_THROW(makeScreenKernel(projectSphere({3.0, 0.0, 0.5}, 1.0, 100.0, {0.0, 0.0})), std::invalid_argument);
