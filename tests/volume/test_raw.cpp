@@ -1,0 +1,249 @@
+// tests/volume/test_raw.cpp — raw volume conversion (volume/raw.h): layout (x fastest),
+// normalisation per type, little-endian decoding, threshold, .gz and plain files, exact
+// size checks (too short, too long, truncated gzip), flag parsing, and the real Engine
+// and Bonsai volumes from ../shared/volumes (skipped when absent).
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "util/error.h"
+#include "volume/grid.h"
+#include "volume/raw.h"
+
+namespace vdbsplat {
+namespace {
+
+namespace fs = std::filesystem;
+using Bytes = std::vector<unsigned char>;
+using openvdb::Coord;
+
+class Raw : public ::testing::Test {
+protected:
+    void SetUp() override {
+        char tmpl[] = "/tmp/vdbsplat_raw_XXXXXX";
+        ASSERT_NE(mkdtemp(tmpl), nullptr);
+        dir_ = tmpl;
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    std::string writePlain(const std::string& name, const Bytes& data) {
+        const std::string path = dir_ + "/" + name;
+        std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(data.data()), data.size());
+        return path;
+    }
+    std::string writeGz(const std::string& name, const Bytes& data) {
+        const std::string path = dir_ + "/" + name;
+        gzFile f = gzopen(path.c_str(), "wb");
+        EXPECT_EQ(gzwrite(f, data.data(), unsigned(data.size())), int(data.size()));
+        gzclose(f);
+        return path;
+    }
+    /// The message of the Error that @p fn throws ("" and a failure when it does not throw).
+    template <typename Fn>
+    static std::string errorOf(Fn fn) {
+        try {
+            fn();
+        } catch (const Error& e) {
+            return e.what();
+        }
+        ADD_FAILURE() << "no Error thrown";
+        return "";
+    }
+    std::string dir_;
+};
+
+Bytes pattern8(int n) {
+    Bytes b(n);
+    for (int i = 0; i < n; ++i) b[i] = static_cast<unsigned char>((i * 37) % 256);
+    return b;
+}
+
+RawSpec spec(int x, int y, int z, RawType type, double threshold = 0.0) {
+    RawSpec s;
+    s.dims = {x, y, z};
+    s.type = type;
+    s.threshold = threshold;
+    return s;
+}
+
+TEST_F(Raw, Uint8LayoutIsXFastestAndNormalised) {
+    const int X = 5, Y = 4, Z = 3;
+    const Bytes data = pattern8(X * Y * Z);
+    RawStats stats;
+    auto grid = convertRaw(writePlain("a.raw", data), spec(X, Y, Z, RawType::UInt8), &stats);
+    uint64_t nonzero = 0;
+    auto acc = grid->getConstAccessor();
+    for (int z = 0; z < Z; ++z)
+        for (int y = 0; y < Y; ++y)
+            for (int x = 0; x < X; ++x) {
+                const unsigned char v = data[x + X * (y + Y * z)];
+                nonzero += v > 0;
+                ASSERT_EQ(acc.isValueOn(Coord(x, y, z)), v > 0) << x << "," << y << "," << z;
+                if (v) ASSERT_FLOAT_EQ(acc.getValue(Coord(x, y, z)), v / 255.0f);
+            }
+    EXPECT_EQ(grid->activeVoxelCount(), nonzero);
+    EXPECT_EQ(stats.active, nonzero);
+    EXPECT_EQ(stats.bytes, uint64_t(X * Y * Z));
+    EXPECT_LT(nonzero, uint64_t(X * Y * Z));  // the pattern has zeros, which stay inactive
+    EXPECT_EQ(grid->getName(), "density");
+}
+
+TEST_F(Raw, GzipAndPlainGiveTheSameGrid) {
+    const Bytes data = pattern8(17 * 9 * 11);
+    auto a = convertRaw(writePlain("a.raw", data), spec(17, 9, 11, RawType::UInt8));
+    auto b = convertRaw(writeGz("a.raw.gz", data), spec(17, 9, 11, RawType::UInt8));
+    ASSERT_EQ(a->activeVoxelCount(), b->activeVoxelCount());
+    auto acc = b->getConstAccessor();
+    for (auto it = a->cbeginValueOn(); it; ++it) ASSERT_EQ(acc.getValue(it.getCoord()), *it);
+}
+
+TEST_F(Raw, Uint16IsLittleEndianOver65535) {
+    const Bytes data{0x00, 0x01, 0xff, 0xff, 0x00, 0x00, 0x01, 0x00};  // 256, 65535, 0, 1
+    auto grid = convertRaw(writeGz("b.raw.gz", data), spec(4, 1, 1, RawType::UInt16));
+    auto acc = grid->getConstAccessor();
+    EXPECT_FLOAT_EQ(acc.getValue(Coord(0, 0, 0)), 256.0f / 65535.0f);
+    EXPECT_FLOAT_EQ(acc.getValue(Coord(1, 0, 0)), 1.0f);
+    EXPECT_FALSE(acc.isValueOn(Coord(2, 0, 0)));
+    EXPECT_FLOAT_EQ(acc.getValue(Coord(3, 0, 0)), 1.0f / 65535.0f);
+    EXPECT_EQ(grid->activeVoxelCount(), 3u);
+}
+
+TEST_F(Raw, Float32KeepsValuesAndLeavesNonFiniteInactive) {
+    const std::vector<float> values{0.25f, -1.0f, NAN, INFINITY, 7.5f, 0.0f};
+    Bytes data;
+    for (float v : values) {
+        const uint32_t bits = std::bit_cast<uint32_t>(v);
+        for (int k = 0; k < 4; ++k) data.push_back(static_cast<unsigned char>(bits >> (8 * k)));
+    }
+    RawStats stats;
+    auto grid = convertRaw(writePlain("f.raw", data), spec(3, 2, 1, RawType::Float32), &stats);
+    auto acc = grid->getConstAccessor();
+    EXPECT_EQ(stats.nonFinite, 2u);
+    EXPECT_EQ(grid->activeVoxelCount(), 2u);
+    EXPECT_EQ(acc.getValue(Coord(0, 0, 0)), 0.25f);
+    EXPECT_EQ(acc.getValue(Coord(1, 1, 0)), 7.5f);  // index 4 = (1, 1, 0)
+    EXPECT_FALSE(acc.isValueOn(Coord(1, 0, 0)));  // negative: not above the default threshold 0
+    EXPECT_FALSE(acc.isValueOn(Coord(2, 0, 0)));  // NaN
+    EXPECT_FALSE(acc.isValueOn(Coord(0, 1, 0)));  // inf
+}
+
+TEST_F(Raw, ThresholdIsStrictAndInNormalisedUnits) {
+    Bytes data(256);
+    for (int i = 0; i < 256; ++i) data[i] = static_cast<unsigned char>(i);
+    const std::string path = writePlain("ramp.raw", data);
+    EXPECT_EQ(convertRaw(path, spec(16, 16, 1, RawType::UInt8, 0.5))->activeVoxelCount(), 128u);  // 128..255
+    EXPECT_EQ(convertRaw(path, spec(16, 16, 1, RawType::UInt8, 30 / 255.0))->activeVoxelCount(), 225u);  // 31..255
+    EXPECT_EQ(convertRaw(path, spec(16, 16, 1, RawType::UInt8, -1.0))->activeVoxelCount(), 256u);
+    EXPECT_EQ(convertRaw(path, spec(16, 16, 1, RawType::UInt8, 1.0))->activeVoxelCount(), 0u);
+}
+
+TEST_F(Raw, SpacingSetsAUniformTransform) {
+    RawSpec s = spec(4, 4, 4, RawType::UInt8);
+    s.spacing = 0.5;
+    Volume v = makeVolume(convertRaw(writePlain("s.raw", Bytes(64, 200)), s));
+    EXPECT_DOUBLE_EQ(v.voxelSize, 0.5);
+    const glm::dvec4 w = v.indexToWorld * glm::dvec4(2, 3, 1, 1);
+    EXPECT_DOUBLE_EQ(w.x, 1.0);
+    EXPECT_DOUBLE_EQ(w.y, 1.5);
+    EXPECT_DOUBLE_EQ(w.z, 0.5);
+}
+
+TEST_F(Raw, SizeMismatchNamesFileAndByteCounts) {
+    const Bytes data = pattern8(100);
+    for (const std::string& path : {writePlain("m.raw", data), writeGz("m.raw.gz", data)}) {
+        std::string short_ = errorOf([&] { convertRaw(path, spec(10, 10, 2, RawType::UInt8)); });
+        EXPECT_NE(short_.find(path), std::string::npos) << short_;
+        EXPECT_NE(short_.find("needs 200 bytes"), std::string::npos) << short_;
+        EXPECT_NE(short_.find("100"), std::string::npos) << short_;
+        std::string long_ = errorOf([&] { convertRaw(path, spec(9, 10, 1, RawType::UInt8)); });
+        EXPECT_NE(long_.find("needs 90 bytes"), std::string::npos) << long_;
+        EXPECT_NE(long_.find("has 100"), std::string::npos) << long_;
+        std::string type = errorOf([&] { convertRaw(path, spec(10, 10, 1, RawType::UInt16)); });
+        EXPECT_NE(type.find("needs 200 bytes"), std::string::npos) << type;
+    }
+}
+
+TEST_F(Raw, TruncatedOrCorruptGzipIsAnError) {
+    const Bytes data = pattern8(64 * 64 * 8);
+    const std::string gz = writeGz("t.raw.gz", data);
+    std::ifstream in(gz, std::ios::binary);
+    Bytes compressed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    compressed.resize(compressed.size() / 2);
+    const std::string cut = writePlain("cut.raw.gz", compressed);
+    EXPECT_NE(errorOf([&] { convertRaw(cut, spec(64, 64, 8, RawType::UInt8)); }).find(cut), std::string::npos);
+    Bytes garbage = compressed;
+    for (size_t i = 20; i < garbage.size(); i += 7) garbage[i] ^= 0x5a;
+    const std::string bad = writePlain("bad.raw.gz", garbage);
+    EXPECT_NE(errorOf([&] { convertRaw(bad, spec(64, 64, 8, RawType::UInt8)); }).find(bad), std::string::npos);
+}
+
+TEST_F(Raw, MissingFileAndDirectory) {
+    EXPECT_NE(errorOf([&] { convertRaw(dir_ + "/nope.raw", spec(1, 1, 1, RawType::UInt8)); }).find("no such file"),
+              std::string::npos);
+    EXPECT_NE(errorOf([&] { convertRaw(dir_, spec(1, 1, 1, RawType::UInt8)); }).find("not a regular file"),
+              std::string::npos);
+}
+
+TEST(RawParse, DimsTypeAndSpacing) {
+    EXPECT_EQ(parseDims("256,256,128", "--dims"), (std::array<int, 3>{256, 256, 128}));
+    for (const char* bad : {"256,256", "1,2,3,4", "0,1,1", "a,b,c", "70000,1,1", "1,,1", "1.5,2,3", ""}) {
+        try {
+            parseDims(bad, "--dims");
+            ADD_FAILURE() << "accepted --dims " << bad;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("--dims"), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_EQ(parseRawType("uint16", "--type"), RawType::UInt16);
+    EXPECT_THROW(parseRawType("int8", "--type"), Error);
+    EXPECT_EQ(parseUniformSpacing("0.5,0.5,0.5", "--spacing"), 0.5);
+    try {
+        parseUniformSpacing("1,1,1.4", "--spacing");
+        ADD_FAILURE() << "accepted non-uniform spacing";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("non-uniform"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--spacing"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(parseUniformSpacing("1,1,0", "--spacing"), Error);
+    EXPECT_THROW(parseUniformSpacing("-1,-1,-1", "--spacing"), Error);
+    EXPECT_THROW(parseUniformSpacing("1,1", "--spacing"), Error);
+}
+
+/// Converts a shared volume, or skips the test when it is absent.
+openvdb::FloatGrid::Ptr sharedVolume(const std::string& name, int z, double threshold) {
+    const std::string path = std::string(VDBSPLAT_SHARED_DIR) + "/volumes/" + name;
+    if (!fs::exists(path)) return nullptr;
+    return convertRaw(path, spec(256, 256, z, RawType::UInt8, threshold));
+}
+
+TEST(RawShared, EngineActiveCountsAndBounds) {
+    auto all = sharedVolume("engine_256x256x128_uint8.raw.gz", 128, 0.0);
+    if (!all) GTEST_SKIP() << "../shared/volumes/engine_256x256x128_uint8.raw.gz is absent";
+    // MANIFEST.md: fraction of voxels > 0 is 0.620, > 30 is 0.158 (of 8,388,608).
+    EXPECT_EQ(all->activeVoxelCount(), 5198360u);
+    EXPECT_NEAR(all->activeVoxelCount() / 8388608.0, 0.620, 0.0005);
+    EXPECT_EQ(all->evalActiveVoxelBoundingBox(), openvdb::CoordBBox(Coord(0, 0, 0), Coord(255, 255, 127)));
+    auto dense = sharedVolume("engine_256x256x128_uint8.raw.gz", 128, 30 / 255.0);
+    EXPECT_EQ(dense->activeVoxelCount(), 1322412u);
+    EXPECT_NEAR(dense->activeVoxelCount() / 8388608.0, 0.158, 0.0005);
+    EXPECT_EQ(dense->evalActiveVoxelBoundingBox(), openvdb::CoordBBox(Coord(61, 24, 0), Coord(203, 222, 107)));
+}
+
+TEST(RawShared, BonsaiActiveFractionsMatchTheManifest) {
+    auto all = sharedVolume("bonsai_256x256x256_uint8.raw.gz", 256, 0.0);
+    if (!all) GTEST_SKIP() << "../shared/volumes/bonsai_256x256x256_uint8.raw.gz is absent";
+    EXPECT_NEAR(all->activeVoxelCount() / 16777216.0, 0.203, 0.0005);
+    auto dense = sharedVolume("bonsai_256x256x256_uint8.raw.gz", 256, 30 / 255.0);
+    EXPECT_NEAR(dense->activeVoxelCount() / 16777216.0, 0.114, 0.0005);
+    const auto box = dense->evalActiveVoxelBoundingBox();
+    EXPECT_TRUE(openvdb::CoordBBox(Coord(0), Coord(255)).isInside(box));
+    EXPECT_GT(box.volume(), 0u);
+}
+
+}  // namespace
+}  // namespace vdbsplat
