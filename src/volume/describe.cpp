@@ -13,6 +13,7 @@
 
 #include "util/error.h"
 #include "volume/grid.h"
+#include "volume/vdb_check.h"
 
 namespace vdbsplat {
 
@@ -101,6 +102,7 @@ std::string describeFile(const std::string& path) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
     if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a regular file");
+    checkVdbStructure(path);  // OpenVDB does not bound its reads on truncated files
     openvdb::io::File file(path);
     try {
         file.open(/*delayLoad=*/false);

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "util/error.h"
+#include "volume/vdb_check.h"
 
 namespace vdbsplat {
 
@@ -21,6 +22,7 @@ void openFile(openvdb::io::File& file, const std::string& path) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
     if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a regular file");
+    checkVdbStructure(path);  // OpenVDB does not bound its reads on truncated files
     try {
         file.open(/*delayLoad=*/false);
     } catch (const std::exception& e) {
