@@ -1,0 +1,161 @@
+// tests/cli/test_cli_volume.cpp — the `info`, `generate` and `convert` commands run as
+// the real binary: --help, exit codes, output files, and for every bad input a non-zero
+// exit, one stderr line "vdbsplat: error: …" naming the file or flag, and no output file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+    int rc = -1;
+    std::string out, err;
+};
+
+class CliVolume : public ::testing::Test {
+protected:
+    void SetUp() override {
+        char tmpl[] = "/tmp/vdbsplat_cli_vol_XXXXXX";
+        ASSERT_NE(mkdtemp(tmpl), nullptr);
+        dir_ = tmpl;
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    std::string path(const std::string& name) const { return dir_ + "/" + name; }
+
+    static std::string slurp(const std::string& p) {
+        std::ifstream in(p);
+        std::stringstream s;
+        s << in.rdbuf();
+        return s.str();
+    }
+
+    /// Runs `vdbsplat <args>` and captures its exit code, stdout and stderr.
+    Result run(const std::string& args) const {
+        const std::string cmd = std::string(VDBSPLAT_BINARY) + " " + args + " >" + path("stdout") + " 2>" + path("stderr");
+        const int status = std::system(cmd.c_str());
+        Result r;
+        r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        r.out = slurp(path("stdout"));
+        r.err = slurp(path("stderr"));
+        return r;
+    }
+
+    /// Expects failure with a single "vdbsplat: error:" line that contains @p needle, and no @p output.
+    void expectError(const std::string& args, const std::string& needle, const std::string& output = "") const {
+        const Result r = run(args);
+        EXPECT_EQ(r.rc, 1) << args;
+        EXPECT_EQ(r.err.rfind("vdbsplat: error: ", 0), 0u) << args << "\n" << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+        EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\nexpected '" << needle << "' in: " << r.err;
+        if (!output.empty()) EXPECT_FALSE(fs::exists(output)) << args;
+        for (const auto& e : fs::directory_iterator(dir_))  // no temporary left behind either
+            EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
+    }
+
+    std::string writeBytes(const std::string& name, size_t n) const {
+        std::string bytes(n, '\0');
+        for (size_t i = 0; i < n; ++i) bytes[i] = char(i % 7 == 0 ? 0 : 1 + i % 200);
+        std::ofstream(path(name), std::ios::binary) << bytes;
+        return path(name);
+    }
+
+    std::string dir_;
+};
+
+TEST_F(CliVolume, HelpExitsZero) {
+    for (const char* cmd : {"info", "generate", "convert"}) {
+        const Result r = run(std::string(cmd) + " --help");
+        EXPECT_EQ(r.rc, 0) << cmd;
+        EXPECT_NE(r.out.find("usage: vdbsplat " + std::string(cmd)), std::string::npos) << r.out;
+        EXPECT_TRUE(r.err.empty()) << r.err;
+    }
+}
+
+TEST_F(CliVolume, GenerateThenInfo) {
+    const std::string out = path("cb.vdb");
+    Result r = run("generate checkerbox -o " + out);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    ASSERT_TRUE(fs::exists(out));
+    r = run("info " + out);
+    EXPECT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.out.find("'density'"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("active voxels: 1000000"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("(0, 0, 0) .. (99, 99, 99)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("voxel size:    (1, 1, 1)"), std::string::npos) << r.out;
+    r = run("generate cloud --active 20000 --seed 5 -o " + path("cloud.vdb"));
+    EXPECT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.out.find("cloud"), std::string::npos) << r.out;
+    r = run("generate marschner-lobb --res 17 -o " + path("ml.vdb"));
+    EXPECT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(run("info " + path("ml.vdb")).out.find("active voxels: 4913"), std::string::npos);
+}
+
+TEST_F(CliVolume, GenerateBadInput) {
+    const std::string out = path("x.vdb");
+    expectError("generate teapot -o " + out, "teapot", out);
+    expectError("generate sphere --res abc -o " + out, "--res", out);
+    expectError("generate sphere --res 0 -o " + out, "--res", out);
+    expectError("generate sphere --res 5000 -o " + out, "--res", out);
+    expectError("generate checkerbox --res 4096 -o " + out, "--res", out);  // 6.9e10 voxels
+    expectError("generate sphere --res 12x -o " + out, "--res", out);
+    expectError("generate cloud --active 0 -o " + out, "--active", out);
+    expectError("generate cloud --active 3000000000 -o " + out, "--active", out);
+    expectError("generate cloud --active 1e5 -o " + out, "--active", out);
+    expectError("generate cloud --seed -3 -o " + out, "--seed", out);
+    expectError("generate sphere --active 100 -o " + out, "--active", out);
+    expectError("generate cloud --res 10 -o " + out, "--res", out);
+    expectError("generate sphere", "-o");
+    expectError("generate -o " + out, "KIND", out);
+    expectError("generate sphere --bogus 1 -o " + out, "--bogus", out);
+    expectError("generate sphere -o " + path("no/such/dir/x.vdb"), "no/such/dir");
+}
+
+TEST_F(CliVolume, ConvertRoundTrip) {
+    const std::string raw = writeBytes("v.raw", 10 * 8 * 6);
+    const std::string out = path("v.vdb");
+    Result r = run("convert " + raw + " -o " + out + " --dims 10,8,6 --type uint8 --spacing 0.5,0.5,0.5");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    r = run("info " + out);
+    EXPECT_NE(r.out.find("active voxels: 411"), std::string::npos) << r.out;  // 480 − ⌈480/7⌉ zeros
+    EXPECT_NE(r.out.find("voxel size:    (0.5, 0.5, 0.5)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("(0, 0, 0) .. (9, 7, 5)"), std::string::npos) << r.out;
+}
+
+TEST_F(CliVolume, ConvertBadInput) {
+    const std::string raw = writeBytes("v.raw", 10 * 8 * 6);
+    const std::string out = path("v.vdb");
+    const std::string ok = " -o " + out + " --dims 10,8,6 --type uint8";
+    expectError("convert " + path("missing.raw") + ok, path("missing.raw") + ": no such file", out);
+    expectError("convert " + raw + " -o " + out + " --dims 10,8,7 --type uint8", "needs 560 bytes", out);
+    expectError("convert " + raw + " -o " + out + " --dims 10,8,5 --type uint8", "has 480", out);
+    expectError("convert " + raw + " -o " + out + " --dims 10,8,6 --type uint16", raw, out);
+    expectError("convert " + raw + " -o " + out + " --dims 10,8 --type uint8", "--dims", out);
+    expectError("convert " + raw + " -o " + out + " --dims 10,8,x --type uint8", "--dims", out);
+    expectError("convert " + raw + " -o " + out + " --dims 10,8,6 --type int8", "--type", out);
+    expectError("convert " + raw + ok + " --spacing 1,1,1.4", "non-uniform", out);
+    expectError("convert " + raw + ok + " --spacing 1,1,0", "--spacing", out);
+    expectError("convert " + raw + ok + " --threshold nan", "--threshold", out);
+    expectError("convert " + raw + ok + " --threshold 2", "--threshold", out);  // nothing above it
+    expectError("convert " + raw + " -o " + out + " --type uint8", "--dims", out);
+    expectError("convert " + raw + " --dims 10,8,6 --type uint8", "-o");
+}
+
+TEST_F(CliVolume, InfoBadInput) {
+    expectError("info " + path("missing.vdb"), path("missing.vdb") + ": no such file");
+    std::ofstream(path("text.vdb")) << "hello\n";
+    expectError("info " + path("text.vdb"), path("text.vdb"));
+    ASSERT_EQ(run("generate sphere --res 20 -o " + path("s.vdb")).rc, 0);
+    const std::string bytes = slurp(path("s.vdb"));
+    for (size_t n : {size_t(9), size_t(60), size_t(128), bytes.size() / 2, bytes.size() - 1}) {
+        std::ofstream(path("cut.vdb"), std::ios::binary).write(bytes.data(), std::streamsize(n));
+        expectError("info " + path("cut.vdb"), path("cut.vdb"));
+    }
+    expectError("info", "FILE.vdb");
+}
+
+}  // namespace
