@@ -58,12 +58,12 @@ Image TileCompositor::image() const {
     return image;
 }
 
-uint64_t TileCompositor::composite(const std::vector<Primitive>& prims, double& binSeconds, double& compositeSeconds) {
+SkippedPrimitives TileCompositor::composite(const std::vector<Primitive>& prims, double& binSeconds, double& compositeSeconds) {
     const auto t0 = Clock::now();
     int64_t slabBase = std::numeric_limits<int64_t>::max();
     for (const Primitive& p : prims)
         if (p.kind != PrimitiveKind::Culled) slabBase = std::min(slabBase, p.slab);
-    uint64_t culled = 0;
+    SkippedPrimitives skipped;
     for (auto& bin : bins_) bin.clear();
     for (uint32_t i = 0; i < prims.size(); ++i) {
         const Primitive& p = prims[i];
@@ -77,7 +77,7 @@ uint64_t TileCompositor::composite(const std::vector<Primitive>& prims, double& 
                 bins_[tile].push_back({key, i});
                 any = true;
             }
-        if (!any) ++culled;
+        if (!any) ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
     }
     binSeconds += since(t0);
     const auto t1 = Clock::now();
@@ -86,7 +86,7 @@ uint64_t TileCompositor::composite(const std::vector<Primitive>& prims, double& 
             if (!bins_[tile].empty()) compositeTile(tile, bins_[tile], prims);
     });
     compositeSeconds += since(t1);
-    return culled;
+    return skipped;
 }
 
 void TileCompositor::over(size_t pixel, float tau, const glm::vec3& color) {

@@ -33,13 +33,18 @@ struct ExactContext {
     double voxelSize = 1.0;
 };
 
+/// Primitives composite() dropped because every tile they touch is already opaque.
+struct SkippedPrimitives {
+    uint64_t points = 0, splats = 0;
+};
+
 class TileCompositor {
 public:
     TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact);
 
     /// @brief Composites @p prims (one depth window, any order) behind everything before.
-    /// @return the number of primitives skipped because every tile they touch is opaque.
-    uint64_t composite(const std::vector<Primitive>& prims, double& binSeconds, double& compositeSeconds);
+    /// @return the primitives skipped because every tile they touch is opaque.
+    SkippedPrimitives composite(const std::vector<Primitive>& prims, double& binSeconds, double& compositeSeconds);
 
     /// @brief True if every pixel of the inclusive rectangle is already opaque (T < ε).
     bool hidden(int x0, int y0, int x1, int y1) const;

@@ -23,7 +23,6 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
     std::vector<Primitive> prims;
-    uint64_t culled = 0;
     while (true) {
         auto t = Clock::now();
         if (!stream.next(batch, hidden)) break;
@@ -32,13 +31,16 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
         projectBatch(batch, ctx, prims);
         for (const Primitive& p : prims) {
             if (p.kind == PrimitiveKind::Point) ++stats.points;
-            else if (p.kind == PrimitiveKind::Culled) ++culled;
-            else ++stats.splats;
+            else if (p.kind != PrimitiveKind::Culled) ++stats.splats;
         }
         stats.projectSeconds += since(t);
-        culled += compositor.composite(prims, stats.rasterizeSeconds, stats.compositeSeconds);
+        const SkippedPrimitives hiddenPrims = compositor.composite(prims, stats.rasterizeSeconds, stats.compositeSeconds);
+        stats.points -= hiddenPrims.points;
+        stats.splats -= hiddenPrims.splats;
     }
-    stats.culled = culled + stream.culledVoxels();
+    // Everything else drew nothing: outside the frustum, behind opaque tiles, off screen,
+    // or transparent under the transfer function.
+    stats.culled = volume.activeVoxels - stats.points - stats.splats;
     return compositor.image();
 }
 
