@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "composite/opacity.h"
 #include "footprint/kernel.h"
 
 namespace vdbsplat {
@@ -89,9 +90,9 @@ SkippedPrimitives TileCompositor::composite(const std::vector<Primitive>& prims,
     return skipped;
 }
 
-void TileCompositor::over(size_t pixel, float tau, const glm::vec3& color) {
+[[gnu::always_inline]] inline void TileCompositor::over(size_t pixel, float tau, const glm::vec3& color) {
     // α = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α   (DESIGN §4)
-    const float alpha = -std::expm1(-tau);
+    const float alpha = opacityFromOpticalDepth(tau);
     float& T = transmittance_[pixel];
     color_[pixel] += T * alpha * color;
     T *= 1.f - alpha;
@@ -160,13 +161,21 @@ void TileCompositor::drawPoint(const Primitive& p, int tx0, int ty0, int tx1, in
 void TileCompositor::drawSplat(const Primitive& p, int tx0, int ty0, int tx1, int ty1) {
     const int x0 = std::max(p.range.x0, tx0), x1 = std::min(p.range.x1, tx1);
     const int y0 = std::max(p.range.y0, ty0), y1 = std::min(p.range.y1, ty1);
+    const float qxx = p.conic.x, qxy = p.conic.y, qyy = p.conic.z;
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y) + 0.5f - p.centre.y;
-        for (int x = x0; x <= x1; ++x) {
+        // The row's chord of the support ellipse, i² < 1:  qxx dx² + 2 qxy dy dx + qyy dy² − 1 < 0.
+        // One pixel of slack on each side; the i² test below decides exactly as before.
+        const float b = qxy * dy, disc = b * b - qxx * (qyy * dy * dy - 1.f);
+        if (!(disc > 0.f)) continue;
+        const float root = std::sqrt(disc);
+        const float lo = p.centre.x - 0.5f + (-b - root) / qxx, hi = p.centre.x - 0.5f + (-b + root) / qxx;
+        const int xa = std::max(x0, int(std::floor(lo))), xb = std::min(x1, int(std::ceil(hi)));
+        for (int x = xa; x <= xb; ++x) {
             const size_t pixel = size_t(y) * width_ + x;
             if (transmittance_[pixel] < kTransmittanceEpsilon) continue;
             const float dx = float(x) + 0.5f - p.centre.x;
-            const float i2 = p.conic.x * dx * dx + 2.f * p.conic.y * dx * dy + p.conic.z * dy * dy;
+            const float i2 = qxx * dx * dx + 2.f * qxy * dx * dy + qyy * dy * dy;
             if (!(i2 < 1.f)) continue;
             over(pixel, p.shader.depositAtIndex2(i2), p.color);
         }
