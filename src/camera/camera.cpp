@@ -10,15 +10,22 @@
 namespace vdbsplat {
 
 namespace {
-bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+/// Finite and small enough that lengths and cross products stay finite in double
+/// (1e300 would overflow |v|² to inf and be misreported as "eye equals look-at").
+constexpr double kMaxCoordinate = 1e15;
+bool finite3(const glm::dvec3& v) {
+    for (int i = 0; i < 3; ++i)
+        if (!(std::isfinite(v[i]) && std::abs(v[i]) <= kMaxCoordinate)) return false;
+    return true;
+}
 }  // namespace
 
 Camera::Camera(const glm::dvec3& eye, const glm::dvec3& lookAt, const glm::dvec3& up,
                double fovDeg, int width, int height)
     : eye_(eye), lookAt_(lookAt), fovDeg_(fovDeg), width_(width), height_(height) {
-    if (!finite3(eye)) throw Error("--eye: coordinates must be finite numbers");
-    if (!finite3(lookAt)) throw Error("--look-at: coordinates must be finite numbers");
-    if (!finite3(up)) throw Error("--up: coordinates must be finite numbers");
+    if (!finite3(eye)) throw Error("--eye: coordinates must be finite numbers of magnitude at most 1e15");
+    if (!finite3(lookAt)) throw Error("--look-at: coordinates must be finite numbers of magnitude at most 1e15");
+    if (!finite3(up)) throw Error("--up: coordinates must be finite numbers of magnitude at most 1e15");
     if (!(fovDeg > 0.0 && fovDeg < 170.0)) throw Error("--fov: must be in (0, 170) degrees");
     if (width < 1 || height < 1) throw Error("--size: image size must be at least 1x1");
     const glm::dvec3 view = lookAt - eye;

@@ -4,6 +4,7 @@
 #include <tbb/global_control.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -35,6 +36,9 @@ const char* kHelp =
     "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
     "  --footprint P      table (default) | exact: per-pixel ray-centre distance instead of the (i, alpha) table\n"
     "  --show-primitives  tint splats red, points keep their colour\n"
+    "  --tables DIR       footprint.table and reindex.table from DIR (default: the shipped tables/);\n"
+    "                     a file absent from DIR is built in memory, a corrupt one or one built for\n"
+    "                     another kernel is refused (hybrid, splat, point)\n"
     "  --spp N            reference: rays per pixel (default 16, rounded up to a square)\n"
     "  --threads N        worker threads (default: all cores); the image does not depend on it\n"
     "  --stats FILE.json  write settings, timings and primitive counts as JSON\n"
@@ -62,6 +66,10 @@ RenderSettings settingsFrom(const Args& args) {
         else throw Error("--footprint: expected 'table' or 'exact', got '" + *v + "'");
     }
     s.showPrimitives = args.has("--show-primitives");
+    if (auto v = args.get("--tables")) {
+        if (v->empty()) throw Error("--tables: expected a directory, got ''");
+        s.tablesDir = *v;
+    }
     if (args.has("--look-at") && !args.has("--eye")) throw Error("--look-at: needs --eye");
     if (args.has("--up") && !args.has("--eye")) throw Error("--up: needs --eye");
     if (auto v = args.get("--eye")) {
@@ -71,6 +79,20 @@ RenderSettings settingsFrom(const Args& args) {
     }
     s.validate();
     return s;
+}
+
+/// The stats file is written after the image: check its folder first, so a bad --stats
+/// path fails before any work and never leaves an image behind.
+void checkStatsPath(const std::string& path, const std::string& image) {
+    namespace fs = std::filesystem;
+    if (path.empty()) throw Error("--stats: expected a file name, got ''");
+    std::error_code ec;
+    const fs::path folder = fs::path(path).parent_path();
+    if (!folder.empty() && !fs::is_directory(folder, ec)) throw Error("--stats: " + path + ": folder does not exist");
+    if (fs::is_directory(path, ec)) throw Error("--stats: " + path + ": is a directory");
+    std::error_code ec1, ec2;
+    const fs::path a = fs::weakly_canonical(path, ec1), b = fs::weakly_canonical(image, ec2);
+    if (!ec1 && !ec2 && a == b) throw Error("--stats: " + path + ": is the output image (-o)");
 }
 
 std::string oneLine(const RenderStats& st, const RenderSettings& s) {
@@ -91,7 +113,7 @@ std::string oneLine(const RenderStats& st, const RenderSettings& s) {
 int runRender(const Argv& argv) {
     const Args args(argv,
                     {"-o", "--grid", "--mode", "--size", "--tf", "--eye", "--look-at", "--up", "--fov", "--distance",
-                     "--threads", "--spp", "--stats", "--threshold", "--footprint"},
+                     "--threads", "--spp", "--stats", "--threshold", "--footprint", "--tables"},
                     {"-v", "--show-primitives"});
     if (args.wantsHelp()) {
         std::cout << kHelp;
@@ -102,12 +124,19 @@ int runRender(const Argv& argv) {
     RenderSettings settings = settingsFrom(args);
     checkImagePath(output);
     const auto statsPath = args.get("--stats");
+    if (statsPath) checkStatsPath(*statsPath, output);
 
     std::unique_ptr<tbb::global_control> threads;
     if (settings.threads > 0)
         threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
 
-    const TransferFunction tf = TransferFunction::fromSpec(settings.transferFunction);
+    const TransferFunction tf = [&] {
+        try {
+            return TransferFunction::fromSpec(settings.transferFunction);
+        } catch (const Error& e) {
+            throw Error(std::string("--tf: ") + e.what());
+        }
+    }();
     const Volume volume = loadVolume(input, settings.gridName);
     if (auto v = args.get("--eye")) {
         if (auto l = args.get("--look-at")) {

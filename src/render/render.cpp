@@ -39,7 +39,8 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
         case RenderMode::Hybrid:
         case RenderMode::Splat:
         case RenderMode::Point: {
-            const Tables tables = loadOrBuildTables();
+            const Tables tables =
+                loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir));
             image = renderForward(volume, table, camera, tables, settings, stats);
             break;
         }

@@ -2,6 +2,7 @@
 #include "render/settings.h"
 
 #include <cmath>
+#include <filesystem>
 
 #include "util/error.h"
 
@@ -35,6 +36,12 @@ void RenderSettings::validate() const {
     if (threads < 0 || threads > 1024) throw Error("--threads: must be in [0, 1024]");
     if (spp < 1 || spp > 1024) throw Error("--spp: must be in [1, 1024]");
     if (!(std::isfinite(threshold) && threshold > 0.0)) throw Error("--threshold: must be a positive number of pixels");
+    if (!tablesDir.empty()) {
+        std::error_code ec;
+        if (!std::filesystem::is_directory(tablesDir, ec))
+            throw Error("--tables: " + tablesDir + ": " +
+                        (std::filesystem::exists(tablesDir, ec) ? "not a directory" : "no such directory"));
+    }
 }
 
 nlohmann::json RenderSettings::toJson() const {
@@ -56,6 +63,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["threshold"] = threshold;
     j["footprint"] = footprint == FootprintPath::Table ? "table" : "exact";
     j["show_primitives"] = showPrimitives;
+    j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
     return j;
 }
 

@@ -27,8 +27,9 @@ struct RenderSettings {
     double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
     FootprintPath footprint = FootprintPath::Table;
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
+    std::string tablesDir;                  ///< footprint/reindex tables; empty: defaultTablesDir()
 
-    /// @throw Error naming the flag of the first invalid value.
+    /// @throw Error naming the flag of the first invalid value (--tables: DIR must be a directory).
     void validate() const;
     nlohmann::json toJson() const;
 };

@@ -1,0 +1,459 @@
+// tests/cli/test_cli_render.cpp — `vdbsplat render` run as the real binary.
+// Bad input, in every mode it applies to (hybrid, splat, point, reference): a non-zero
+// exit, exactly one stderr line "vdbsplat: error: …" naming the file or flag, and an
+// output folder left empty (no image, no temporary). A failed render never clobbers an
+// existing image. Good renders: each mode to PNG and EXR, the --stats JSON, the image
+// independent of --threads and of --tables (shipped, a copy, or built in memory).
+//
+// Every run is a separate process (≈ 0.2 s of dynamic symbol binding each: OpenImageIO
+// pulls in some 260 shared libraries), so the runs of a test go through a small pool of
+// threads, and a bad value that the flag parser rejects before the mode is looked at
+// runs in one mode, rotating over the four (VDBSPLAT_TEST_ALL_MODES=1 runs it in all).
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "image/image.h"
+#include "volume/generate.h"
+#include "volume/grid.h"
+
+extern char** environ;
+
+namespace vdbsplat {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::vector<std::string> kAllModes = {"hybrid", "splat", "point", "reference"};
+const std::vector<std::string> kForwardModes = {"hybrid", "splat", "point"};
+
+struct Result {
+    int rc = -1;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+void spit(const fs::path& p, const std::string& bytes) {
+    std::ofstream out(p, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    ASSERT_TRUE(out.good()) << p;
+}
+
+/// Runs `vdbsplat ARGS…` (no shell), stdout and stderr captured through files in @p logDir.
+Result runBinary(const std::vector<std::string>& args, const fs::path& logDir) {
+    const std::string outPath = (logDir / "stdout").string(), errPath = (logDir / "stderr").string();
+    std::vector<std::string> all{VDBSPLAT_BINARY};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = 0;
+    const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    Result r;
+    if (spawned != 0) {
+        r.err = "posix_spawn failed";
+        return r;
+    }
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = slurp(outPath);
+    r.err = slurp(errPath);
+    return r;
+}
+
+/// Calls fn(0 … n−1) on a few threads (the processes they start do the work).
+void parallelFor(size_t n, const std::function<void(size_t)>& fn) {
+    const size_t workers = std::min<size_t>(n, std::clamp<size_t>(std::thread::hardware_concurrency(), 2, 4));
+    std::atomic<size_t> next{0};
+    std::vector<std::thread> pool;
+    for (size_t w = 0; w < workers; ++w)
+        pool.emplace_back([&] {
+            for (size_t i; (i = next++) < n;) fn(i);
+        });
+    for (auto& t : pool) t.join();
+}
+
+std::vector<std::string> listDir(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+bool contains(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+
+/// One bad input: run in each of @p modes ("" = no --mode from the loop).
+struct BadCase {
+    std::string input;               ///< the .vdb argument
+    std::vector<std::string> flags;  ///< appended after the defaults
+    std::string needle;              ///< the file or flag the error line must name
+    std::vector<std::string> modes = kAllModes;
+    bool parsing = false;  ///< rejected by the flag parser, whatever the mode: one mode suffices
+};
+
+constexpr bool kParsing = true;
+
+/// The input files, made once for the whole suite.
+class CliRender : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        char tmpl[] = "/tmp/vdbsplat_cli_render_XXXXXX";
+        ASSERT_NE(mkdtemp(tmpl), nullptr);
+        shared_ = tmpl;
+        fs::create_directories(shared_ / "log");
+        initOpenVdb();
+        GenerateOptions sphere;  // what `vdbsplat generate sphere --res 16` writes, without a process
+        sphere.kind = "sphere";
+        sphere.res = 16;
+        writeVolume(vdb("sphere.vdb"), generateVolume(sphere));
+        const std::string bytes = slurp(vdb("sphere.vdb"));
+        ASSERT_GT(bytes.size(), 1000u);
+        spit(vdb("half.vdb"), bytes.substr(0, bytes.size() / 2));  // truncated
+        std::string junk(3000, '\0');
+        for (size_t i = 0; i < junk.size(); ++i) junk[i] = char((i * 2654435761u) >> 13);
+        spit(vdb("junk.vdb"), junk);  // not a VDB
+
+        auto ints = openvdb::Int32Grid::create();
+        ints->setName("labels");
+        ints->tree().setValueOn(openvdb::Coord(1, 2, 3), 4);
+        auto vel = openvdb::Vec3SGrid::create();
+        vel->setName("vel");
+        vel->tree().setValueOn(openvdb::Coord(0), openvdb::Vec3s(1, 0, 0));
+        openvdb::io::File(vdb("nofloat.vdb")).write({ints, vel});
+        auto empty = openvdb::FloatGrid::create(0.0f);
+        empty->setName("density");
+        openvdb::io::File(vdb("empty.vdb")).write({empty});
+
+        // Tables: a pristine copy, one payload byte flipped, another kernel in the header.
+        const fs::path shipped = fs::path(VDBSPLAT_SOURCE_DIR) / "tables";
+        const std::string fp = slurp(shipped / "footprint.table"), ri = slurp(shipped / "reindex.table");
+        ASSERT_FALSE(fp.empty());
+        ASSERT_FALSE(ri.empty());
+        for (const char* d : {"t_copy", "t_empty", "t_flip", "t_kernel", "t_rflip"}) fs::create_directories(shared_ / d);
+        spit(shared_ / "t_copy" / "footprint.table", fp);
+        spit(shared_ / "t_copy" / "reindex.table", ri);
+        spit(shared_ / "t_flip" / "footprint.table", flipPayloadByte(fp));
+        spit(shared_ / "t_rflip" / "reindex.table", flipPayloadByte(ri));
+        // The checksum covers the payload only, so this header edit is caught by the
+        // kernel identity check, not by the checksum.
+        std::string k = fp;
+        for (const auto& [from, to] : {std::pair<std::string, std::string>("kernel gaussian-s0.65-R2.0\n", "kernel gaussian-s0.50-R2.0\n"),
+                                       std::pair<std::string, std::string>("sigma 0.65\n", "sigma 0.5\n")}) {
+            const size_t at = k.find(from);
+            ASSERT_NE(at, std::string::npos) << "tables/footprint.table header changed: " << from;
+            ASSERT_LT(at, k.find("end_header\n"));
+            k.replace(at, from.size(), to);
+        }
+        spit(shared_ / "t_kernel" / "footprint.table", k);
+    }
+    static void TearDownTestSuite() {
+        std::error_code ec;
+        fs::remove_all(shared_, ec);
+    }
+    static std::string flipPayloadByte(std::string bytes) {
+        const size_t payload = bytes.find("end_header\n") + std::string("end_header\n").size();
+        EXPECT_LT(payload + 1000, bytes.size());
+        bytes[payload + 1000] = char(bytes[payload + 1000] ^ 0x10);
+        return bytes;
+    }
+    static std::string vdb(const std::string& name) { return (shared_ / name).string(); }
+    static std::string tables(const std::string& name) { return (shared_ / name).string(); }
+
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = shared_ / info->name();
+        fs::create_directories(dir_);
+    }
+
+    /// A fresh, empty output folder and log folder for one run.
+    fs::path runDir(const std::string& name) const {
+        const fs::path d = dir_ / name;
+        fs::create_directories(d / "out");
+        fs::create_directories(d / "log");
+        return d;
+    }
+
+    /// `render INPUT -o OUT --size 16x16 --spp 1 [--mode MODE] FLAGS…` (defaults left out when FLAGS has them).
+    static std::vector<std::string> renderArgs(const std::string& input, const std::string& output,
+                                               const std::string& mode, const std::vector<std::string>& flags) {
+        std::vector<std::string> a{"render", input, "-o", output};
+        if (!contains(flags, "--size")) a.insert(a.end(), {"--size", "16x16"});
+        if (!contains(flags, "--spp")) a.insert(a.end(), {"--spp", "1"});
+        if (!mode.empty()) a.insert(a.end(), {"--mode", mode});
+        a.insert(a.end(), flags.begin(), flags.end());
+        return a;
+    }
+
+    /// Runs every case in every one of its modes and checks each failure.
+    void expectAllFail(const std::vector<BadCase>& cases) {
+        struct Run {
+            size_t c;
+            std::string mode;
+            std::vector<std::string> args;
+            fs::path out, outDir;
+            Result r;
+        };
+        std::vector<Run> runs;
+        const bool allModes = std::getenv("VDBSPLAT_TEST_ALL_MODES") != nullptr;
+        for (size_t c = 0; c < cases.size(); ++c) {
+            std::vector<std::string> modes = cases[c].modes;
+            if (cases[c].parsing && !allModes && modes.size() > 1) modes = {modes[(rotation_++) % modes.size()]};
+            for (const std::string& mode : modes) {
+                const fs::path d = runDir("c" + std::to_string(c) + "_" + (mode.empty() ? "nomode" : mode));
+                // Alternate the output format so both writers' paths are covered.
+                const fs::path out = d / "out" / (runs.size() % 2 ? "image.exr" : "image.png");
+                runs.push_back({c, mode, renderArgs(cases[c].input, out.string(), mode, cases[c].flags), out, d / "out", {}});
+            }
+        }
+        parallelFor(runs.size(), [&](size_t i) { runs[i].r = runBinary(runs[i].args, runs[i].outDir.parent_path() / "log"); });
+        const bool print = std::getenv("VDBSPLAT_PRINT_ERRORS") != nullptr;
+        for (const Run& run : runs) {
+            std::string cmd;
+            for (size_t k = 1; k < run.args.size(); ++k) cmd += " " + run.args[k];
+            SCOPED_TRACE("render" + cmd);
+            const std::string& err = run.r.err;
+            EXPECT_EQ(run.r.rc, 1);
+            EXPECT_EQ(err.rfind("vdbsplat: error: ", 0), 0u) << err;
+            EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+            EXPECT_TRUE(!err.empty() && err.back() == '\n') << err;
+            EXPECT_NE(err.find(cases[run.c].needle), std::string::npos) << "expected '" << cases[run.c].needle << "' in: " << err;
+            EXPECT_TRUE(run.r.out.empty()) << run.r.out;
+            EXPECT_FALSE(fs::exists(run.out));
+            EXPECT_TRUE(listDir(run.outDir).empty()) << "left behind: " << listDir(run.outDir).front();
+            if (print) std::cout << "[" << (run.mode.empty() ? "-" : run.mode) << "]" << cmd << "\n    " << err;
+        }
+    }
+
+    static fs::path shared_;
+    static size_t rotation_;
+    fs::path dir_;
+};
+
+fs::path CliRender::shared_;
+size_t CliRender::rotation_ = 0;
+
+TEST_F(CliRender, HelpDocumentsTablesAndExitsZero) {
+    const Result r = runBinary({"render", "--help"}, runDir("help") / "log");
+    EXPECT_EQ(r.rc, 0);
+    EXPECT_TRUE(r.err.empty()) << r.err;
+    EXPECT_NE(r.out.find("usage: vdbsplat render"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--tables DIR"), std::string::npos) << r.out;
+}
+
+TEST_F(CliRender, BadVolumeInputs) {
+    const std::string missing = vdb("missing.vdb");
+    expectAllFail({
+        {missing, {}, missing + ": no such file"},
+        {vdb("junk.vdb"), {}, vdb("junk.vdb") + ": not a VDB file"},
+        {vdb("half.vdb"), {}, vdb("half.vdb") + ": truncated or corrupt"},
+        {vdb("nofloat.vdb"), {}, vdb("nofloat.vdb")},
+        {vdb("sphere.vdb"), {"--grid", "temperature"}, vdb("sphere.vdb") + ": no grid named 'temperature'"},
+        {vdb("empty.vdb"), {}, vdb("empty.vdb")},
+    });
+}
+
+TEST_F(CliRender, BadFlagValues) {
+    const std::string s = vdb("sphere.vdb");
+    expectAllFail({
+        {s, {"--mode", "bogus"}, "--mode: unknown mode 'bogus'", {""}},
+        {s, {"--tf", "no-such-preset"}, "--tf"},
+        {s, {"--size", "4OOx400"}, "--size", kAllModes, kParsing},
+        {s, {"--size", "0x0"}, "--size", kAllModes, kParsing},
+        {s, {"--size", "100000x100000"}, "--size", kAllModes, kParsing},
+        {s, {"--fov", "abc"}, "--fov", kAllModes, kParsing},
+        {s, {"--fov", "0"}, "--fov", kAllModes, kParsing},
+        {s, {"--fov", "180"}, "--fov", kAllModes, kParsing},
+        {s, {"--spp", "1.5"}, "--spp", kAllModes, kParsing},
+        {s, {"--threshold", "x"}, "--threshold", kAllModes, kParsing},
+        {s, {"--threshold", "0"}, "--threshold", kAllModes, kParsing},
+        {s, {"--threshold", "-1"}, "--threshold", kAllModes, kParsing},
+        {s, {"--footprint", "bogus"}, "--footprint", kAllModes, kParsing},
+        {s, {"--stats", (shared_ / "no" / "such" / "s.json").string()}, "--stats", kAllModes, kParsing},
+        {s, {"--tables", tables("t_nowhere")}, "--tables: " + tables("t_nowhere") + ": no such directory", kAllModes, kParsing},
+        {s, {"--tables", s}, "--tables: " + s + ": not a directory", kAllModes, kParsing},
+    });
+}
+
+TEST_F(CliRender, BadCameras) {
+    const std::string s = vdb("sphere.vdb");
+    expectAllFail({
+        {s, {"--eye", "1,2"}, "--eye", kAllModes, kParsing},
+        {s, {"--eye", "nan,0,0"}, "--eye", kAllModes, kParsing},
+        {s, {"--eye", "inf,0,0"}, "--eye", kAllModes, kParsing},
+        {s, {"--eye", "1e300,0,0"}, "--eye"},
+        {s, {"--eye", "1,2,3", "--look-at", "1,2,3"}, "--eye: equals --look-at"},
+        {s, {"--eye", "7.5,7.5,7.5"}, "--eye: equals --look-at"},  // the default look-at: the grid's centre
+        {s, {"--eye", "7.5,7.5,40", "--look-at", "7.5,7.5,0", "--up", "0,0,1"}, "--up: parallel"},
+    });
+}
+
+TEST_F(CliRender, BadTablesNameTheTableFile) {
+    const std::string s = vdb("sphere.vdb");
+    const std::string flip = tables("t_flip"), kernel = tables("t_kernel"), rflip = tables("t_rflip");
+    expectAllFail({
+        {s, {"--tables", flip}, flip + "/footprint.table: checksum mismatch", kForwardModes},
+        {s, {"--tables", kernel}, kernel + "/footprint.table: table built for kernel 'gaussian-s0.50-R2.0'", kForwardModes},
+        {s, {"--tables", rflip}, rflip + "/reindex.table: checksum mismatch", kForwardModes},
+    });
+}
+
+TEST_F(CliRender, FailedRenderDoesNotClobberAnExistingImage) {
+    const std::string s = vdb("sphere.vdb");
+    const std::string keep = "not an image: these bytes must survive a failed render\n";
+    struct Run {
+        std::vector<std::string> args;
+        fs::path out;
+        Result r;
+    };
+    std::vector<Run> runs;
+    struct Failure {
+        std::string input;
+        std::vector<std::string> flags;
+        std::vector<std::string> modes;  // two each, all four covered
+    };
+    const std::string missing = vdb("missing.vdb");
+    const std::vector<Failure> failures = {
+        {s, {"--fov", "abc"}, {"hybrid", "reference"}},                                         // flag parsing
+        {missing, {}, {"splat", "point"}},                                                      // loading
+        {s, {"--stats", (shared_ / "no" / "dir" / "s.json").string()}, {"point", "reference"}},  // output checks
+        {s, {"--eye", "1,2,3", "--look-at", "1,2,3"}, {"hybrid", "splat"}},                     // camera, after loading
+        {s, {"--tables", tables("t_flip")}, {"hybrid", "point"}},                               // inside render()
+    };
+    for (size_t f = 0; f < failures.size(); ++f)
+        for (size_t m = 0; m < failures[f].modes.size(); ++m) {
+            const std::string& mode = failures[f].modes[m];
+            const fs::path d = runDir(mode + std::to_string(f));
+            const fs::path out = d / "out" / ((f + m) % 2 ? "out.exr" : "out.png");
+            spit(out, keep);
+            runs.push_back({renderArgs(failures[f].input, out.string(), mode, failures[f].flags), out, {}});
+        }
+    parallelFor(runs.size(), [&](size_t i) { runs[i].r = runBinary(runs[i].args, runs[i].out.parent_path().parent_path() / "log"); });
+    for (const Run& run : runs) {
+        std::string cmd;
+        for (const std::string& a : run.args) cmd += " " + a;
+        SCOPED_TRACE(cmd);
+        EXPECT_EQ(run.r.rc, 1) << run.r.err;
+        EXPECT_EQ(slurp(run.out), keep);
+        EXPECT_EQ(listDir(run.out.parent_path()), std::vector<std::string>{run.out.filename().string()});
+    }
+}
+
+TEST_F(CliRender, GoodRenderInEachModeToPngAndExr) {
+    struct Run {
+        std::string mode;
+        std::vector<std::string> args;
+        fs::path out;
+        Result r;
+    };
+    std::vector<Run> runs;
+    for (const std::string& mode : kAllModes)
+        for (const char* ext : {".png", ".exr"}) {
+            const fs::path d = runDir(mode + ext);
+            const fs::path out = d / "out" / (std::string("img") + ext);
+            runs.push_back({mode, renderArgs(vdb("sphere.vdb"), out.string(), mode, {"--size", "24x20"}), out, {}});
+        }
+    parallelFor(runs.size(), [&](size_t i) { runs[i].r = runBinary(runs[i].args, runs[i].out.parent_path().parent_path() / "log"); });
+    for (const Run& run : runs) {
+        SCOPED_TRACE(run.mode + " " + run.out.filename().string());
+        ASSERT_EQ(run.r.rc, 0) << run.r.err;
+        EXPECT_TRUE(run.r.err.empty()) << run.r.err;
+        ASSERT_TRUE(fs::exists(run.out));
+        EXPECT_EQ(listDir(run.out.parent_path()), std::vector<std::string>{run.out.filename().string()});  // no temporary
+        const Image img = readImage(run.out.string());
+        EXPECT_EQ(img.width, 24);
+        EXPECT_EQ(img.height, 20);
+        float peak = 0.0f;
+        for (const glm::vec4& p : img.pixels) peak = std::max(peak, p.x);
+        EXPECT_GT(peak, 0.05f) << "the sphere is in the picture";
+        const glm::vec4 corner = img.pixels.front();
+        EXPECT_LT(std::max({corner.x, corner.y, corner.z}), 1e-3f) << "the corner is empty";
+    }
+}
+
+TEST_F(CliRender, StatsJsonHasCountsTimingsAndSettings) {
+    const fs::path d = runDir("stats");
+    const fs::path stats = d / "out" / "s.json";
+    const Result r = runBinary(renderArgs(vdb("sphere.vdb"), (d / "out" / "img.png").string(), "hybrid",
+                                          {"--size", "32x32", "--stats", stats.string(), "-v"}),
+                               d / "log");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.out.find("hybrid 32x32"), std::string::npos) << r.out;
+    const nlohmann::json j = nlohmann::json::parse(slurp(stats));
+    for (const char* key : {"seconds", "width", "height", "active_voxels", "mode", "points", "splats", "culled",
+                            "splat_fraction", "stage_seconds", "tables", "camera", "input", "grid"})
+        EXPECT_TRUE(j.contains(key)) << key << " in " << j.dump();
+    EXPECT_EQ(j["mode"], "hybrid");
+    EXPECT_EQ(j["width"], 32);
+    EXPECT_EQ(j["height"], 32);
+    EXPECT_EQ(j["grid"], "density");
+    EXPECT_EQ(j["tables"], "");
+    EXPECT_GT(j["active_voxels"].get<double>(), 1000.0);
+    EXPECT_GE(j["seconds"].get<double>(), 0.0);
+    EXPECT_GT(j["points"].get<double>(), 0.0);  // this view has both kinds
+    EXPECT_GT(j["splats"].get<double>(), 0.0);
+    EXPECT_GE(j["culled"].get<double>(), 0.0);
+    const double drawn = j["points"].get<double>() + j["splats"].get<double>();
+    EXPECT_NEAR(j["splat_fraction"].get<double>(), j["splats"].get<double>() / drawn, 1e-12);
+    for (const char* stage : {"stream", "project", "rasterize", "composite"}) {
+        ASSERT_TRUE(j["stage_seconds"].contains(stage)) << stage;
+        EXPECT_GE(j["stage_seconds"][stage].get<double>(), 0.0) << stage;
+    }
+    EXPECT_EQ(listDir(d / "out"), (std::vector<std::string>{"img.png", "s.json"}));
+}
+
+TEST_F(CliRender, ImageIndependentOfThreadsAndOfTablesSource) {
+    // 32x32 hybrid: a mix of points and splats (checked in StatsJsonHasCountsTimingsAndSettings).
+    const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
+        {"t2", {"--threads", "2"}},
+        {"t1", {"--threads", "1"}},
+        {"t2copy", {"--threads", "2", "--tables", tables("t_copy")}},    // a copy of the shipped tables
+        {"t1built", {"--threads", "1", "--tables", tables("t_empty")}},  // no files: built in memory
+    };
+    std::vector<fs::path> outs;
+    std::vector<Result> results(variants.size());
+    std::vector<std::vector<std::string>> args;
+    for (const auto& [name, flags] : variants) {
+        const fs::path d = runDir(name);
+        outs.push_back(d / "out" / "img.png");
+        std::vector<std::string> f = flags;
+        f.insert(f.end(), {"--size", "32x32"});
+        args.push_back(renderArgs(vdb("sphere.vdb"), outs.back().string(), "hybrid", f));
+    }
+    parallelFor(variants.size(), [&](size_t i) { results[i] = runBinary(args[i], outs[i].parent_path().parent_path() / "log"); });
+    for (size_t i = 0; i < variants.size(); ++i) ASSERT_EQ(results[i].rc, 0) << variants[i].first << ": " << results[i].err;
+    const std::string first = slurp(outs[0]);
+    ASSERT_GT(first.size(), 100u);
+    for (size_t i = 1; i < variants.size(); ++i) EXPECT_TRUE(slurp(outs[i]) == first) << variants[i].first << " differs";
+}
+
+}  // namespace
+}  // namespace vdbsplat
