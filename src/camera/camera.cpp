@@ -64,8 +64,15 @@ Camera makeCamera(const CameraSpec& spec, const glm::dvec3& boxMin, const glm::d
     const double half = std::min(halfV, halfH);
     // The bounding sphere's silhouette spans 80% of that field: sin(0.8·half) = radius / D.
     const double framing = radius / std::sin(0.8 * half);
-    const glm::dvec3 eye = centre + defaultViewDirection() * (framing * spec.distance);
-    return Camera(eye, centre, glm::dvec3(0.0, 0.0, 1.0), spec.fovDeg, spec.width, spec.height);
+    glm::dvec3 direction = defaultViewDirection();
+    if (spec.hasViewDir) {
+        const double length = glm::length(spec.viewDir);
+        if (!(std::isfinite(length) && length > 0.0 && length < 1e300))
+            throw Error("--view-dir: must be a finite, non-zero direction");
+        direction = spec.viewDir / length;
+    }
+    const glm::dvec3 eye = centre + direction * (framing * spec.distance);
+    return Camera(eye, centre, spec.up, spec.fovDeg, spec.width, spec.height);
 }
 
 }  // namespace vdbsplat

@@ -21,6 +21,8 @@ struct CameraSpec {
     bool hasEye = false;            ///< false: frame the bounding box (see frameBox)
     glm::dvec3 eye{0.0}, lookAt{0.0}, up{0.0, 0.0, 1.0};
     double distance = 1.0;          ///< multiplies the framing distance (8 far, 1 framed, 0.35 close)
+    bool hasViewDir = false;        ///< framing: false uses defaultViewDirection()
+    glm::dvec3 viewDir{0.0};        ///< framing: direction from the box centre to the eye (any length)
 };
 
 class Camera {

@@ -52,6 +52,8 @@ const char* kHelp =
     "  --modes LIST         comma-separated, from hybrid, splat, point, reference\n"
     "                       (default hybrid,splat,point; reference is slow)\n"
     "  --distances LIST     comma-separated framing distances (default 8,1,0.35)\n"
+    "  --view-dir X,Y,Z     framing direction, centre to eye (default 0.9,-1.3,0.75)\n"
+    "  --up X,Y,Z           up vector (default 0,0,1)\n"
     "  --threshold PX       minification threshold of hybrid mode in pixels (default 1)\n"
     "  --footprint P        table (default) | exact\n"
     "  --json FILE.json     also write every run, the per-stage medians and the ratios as JSON\n"
@@ -140,6 +142,15 @@ Options optionsFrom(const Args& args) {
         else if (*v == "exact") s.footprint = FootprintPath::Exact;
         else throw Error("--footprint: expected 'table' or 'exact', got '" + *v + "'");
     }
+    if (auto v = args.get("--view-dir")) {
+        const auto d = parseDoubleList(*v, "--view-dir", 3);
+        s.camera.hasViewDir = true;
+        s.camera.viewDir = {d[0], d[1], d[2]};
+    }
+    if (auto v = args.get("--up")) {
+        const auto u = parseDoubleList(*v, "--up", 3);
+        s.camera.up = {u[0], u[1], u[2]};
+    }
     if (auto v = args.get("--runs")) o.runs = int(parseInt(*v, "--runs", 1, kMaxRuns));
     if (auto v = args.get("--warmup")) o.warmup = int(parseInt(*v, "--warmup", 0, kMaxWarmup));
     if (auto v = args.get("--modes")) o.modes = parseModes(*v);
@@ -196,7 +207,7 @@ std::string formatDistance(double d) {
 int runBench(const Argv& argv) {
     const Args args(argv,
                     {"--grid", "--tf", "--size", "--runs", "--warmup", "--threads", "--modes", "--distances",
-                     "--threshold", "--footprint", "--json"},
+                     "--threshold", "--footprint", "--json", "--view-dir", "--up"},
                     {"-v"});
     if (args.wantsHelp()) {
         std::cout << kHelp;

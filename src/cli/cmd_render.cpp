@@ -31,6 +31,8 @@ const char* kHelp =
     "  --eye X,Y,Z        camera position (world); default: frame the grid from a fixed oblique view\n"
     "  --look-at X,Y,Z    point looked at (default: the centre of the grid's bounds)\n"
     "  --up X,Y,Z         up vector (default 0,0,1)\n"
+    "  --view-dir X,Y,Z   without --eye: frame the grid from this direction (centre to eye;\n"
+    "                     default 0.9,-1.3,0.75)\n"
     "  --fov DEG          vertical field of view (default 30)\n"
     "  --distance K       multiplies the framing distance (8 far, 1 framed, 0.35 close)\n"
     "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
@@ -71,11 +73,15 @@ RenderSettings settingsFrom(const Args& args) {
         s.tablesDir = *v;
     }
     if (args.has("--look-at") && !args.has("--eye")) throw Error("--look-at: needs --eye");
-    if (args.has("--up") && !args.has("--eye")) throw Error("--up: needs --eye");
+    if (args.has("--view-dir") && args.has("--eye")) throw Error("--view-dir: not with --eye (it sets the framing direction)");
+    if (auto u = args.get("--up")) s.camera.up = parseVec3(*u, "--up");
+    if (auto v = args.get("--view-dir")) {
+        s.camera.hasViewDir = true;
+        s.camera.viewDir = parseVec3(*v, "--view-dir");
+    }
     if (auto v = args.get("--eye")) {
         s.camera.hasEye = true;
         s.camera.eye = parseVec3(*v, "--eye");
-        if (auto u = args.get("--up")) s.camera.up = parseVec3(*u, "--up");
     }
     s.validate();
     return s;
@@ -112,7 +118,7 @@ std::string oneLine(const RenderStats& st, const RenderSettings& s) {
 
 int runRender(const Argv& argv) {
     const Args args(argv,
-                    {"-o", "--grid", "--mode", "--size", "--tf", "--eye", "--look-at", "--up", "--fov", "--distance",
+                    {"-o", "--grid", "--mode", "--size", "--tf", "--eye", "--look-at", "--up", "--view-dir", "--fov", "--distance",
                      "--threads", "--spp", "--stats", "--threshold", "--footprint", "--tables"},
                     {"-v", "--show-primitives"});
     if (args.wantsHelp()) {

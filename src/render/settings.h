@@ -37,7 +37,8 @@ struct RenderSettings {
 struct RenderStats {
     double seconds = 0.0;
     uint64_t activeVoxels = 0;
-    uint64_t points = 0, splats = 0, culled = 0;
+    uint64_t points = 0, splats = 0;  ///< primitives drawn (not hidden behind opaque tiles)
+    uint64_t culled = 0;              ///< active voxels that drew nothing (frustum, occlusion, off screen, σ = 0)
     uint64_t rays = 0;  ///< reference: rays traced
     double streamSeconds = 0.0, projectSeconds = 0.0, rasterizeSeconds = 0.0, compositeSeconds = 0.0;
     nlohmann::json toJson() const;

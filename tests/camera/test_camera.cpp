@@ -275,6 +275,32 @@ TEST(Camera, DistanceScalesTheEyeDistance) {
     EXPECT_NEAR(a / b, 2.0, 0.01);
 }
 
+// --view-dir and --up steer the framing: the eye lies along the direction at the same
+// distance, the box stays centred, and the up vector is the image's up.
+TEST(Camera, ViewDirAndUpSteerTheFraming) {
+    const glm::dvec3 lo(0, 0, 0), hi(99, 49, 29), centre = 0.5 * (lo + hi);
+    CameraSpec spec;
+    const double d1 = glm::length(makeCamera(spec, lo, hi).eye() - centre);
+    spec.hasViewDir = true;
+    spec.viewDir = {0.0, 0.0, 5.0};  // any length
+    spec.up = {0.0, 1.0, 0.0};
+    const Camera top = makeCamera(spec, lo, hi);
+    EXPECT_NEAR(glm::length(top.eye() - (centre + glm::dvec3(0.0, 0.0, d1))), 0.0, 1e-9 * d1);
+    // Looking down −z with +y up: a point above the centre in y lands above the image centre.
+    const PixelCoord above = top.project(top.toView(centre + glm::dvec3(0.0, 10.0, 0.0)));
+    EXPECT_LT(above.y, top.principal().y - 1.0);
+    EXPECT_NEAR(above.x, top.principal().x, 1e-9);
+    spec.viewDir = {0.0, 0.0, 0.0};
+    EXPECT_THROW(makeCamera(spec, lo, hi), Error);
+    spec.viewDir = {0.0, 3.0, 0.0};  // parallel to up
+    try {
+        makeCamera(spec, lo, hi);
+        ADD_FAILURE() << "up parallel to the view direction was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("--up"), std::string::npos) << e.what();
+    }
+}
+
 TEST(Camera, InvalidCamerasNameTheFlag) {
     const glm::dvec3 e(1, 2, 3), at(0, 0, 0), z(0, 0, 1);
     const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();

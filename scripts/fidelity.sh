@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The fidelity table of docs/fidelity.md: PSNR/SSIM of hybrid, splat and point against the
+# reference renderer for the checker box, Marschner-Lobb and the converted Engine at the
+# three standard views (--distance 8, 1, 0.35), 400x400. Reference images are cached in
+# out/fidelity/ (delete them to re-render). Usage: scripts/fidelity.sh [--spp N]
+# Writes out/fidelity/fidelity.md (a Markdown table) and out/fidelity/fidelity.tsv.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SPP=16
+[[ "${1:-}" == "--spp" ]] && SPP=$2
+scripts/build.sh >/dev/null
+BIN=${BUILD_DIR:-build}/vdbsplat
+OUT=out/fidelity
+mkdir -p "$OUT"
+ENGINE=../shared/volumes/engine_256x256x128_uint8.raw.gz
+
+[[ -f $OUT/checkerbox.vdb ]] || "$BIN" generate checkerbox -o $OUT/checkerbox.vdb >/dev/null
+[[ -f $OUT/marschner-lobb.vdb ]] || "$BIN" generate marschner-lobb -o $OUT/marschner-lobb.vdb >/dev/null
+VOLUMES="checkerbox:grey marschner-lobb:grey"
+if [[ -f $ENGINE ]]; then
+  [[ -f $OUT/engine.vdb ]] || "$BIN" convert $ENGINE -o $OUT/engine.vdb --dims 256,256,128 --type uint8 \
+      --threshold 0.1176 >/dev/null
+  VOLUMES="$VOLUMES engine:ct-bone"
+else
+  echo "fidelity: $ENGINE absent, skipping the Engine rows" >&2
+fi
+
+printf "volume\tdistance\tmode\tpsnr_db\tssim\tsplat_pct\tseconds\n" > $OUT/fidelity.tsv
+for entry in $VOLUMES; do
+  vol=${entry%%:*} tf=${entry##*:}
+  for d in 8 1 0.35; do
+    ref=$OUT/${vol}_d${d}_reference.exr
+    if [[ ! -f $ref ]]; then
+      "$BIN" render $OUT/$vol.vdb -o $ref --mode reference --tf $tf --distance $d --spp $SPP \
+          --stats $OUT/${vol}_d${d}_reference.json
+    fi
+    for mode in hybrid splat point; do
+      img=$OUT/${vol}_d${d}_${mode}.exr
+      "$BIN" render $OUT/$vol.vdb -o $img --mode $mode --tf $tf --distance $d --stats $OUT/stats.json
+      m=$("$BIN" compare $img $ref)
+      psnr=$(sed -E 's/.*psnr=([^ ]+) dB.*/\1/' <<<"$m")
+      ssim=$(sed -E 's/.*ssim=([^ ]+) .*/\1/' <<<"$m")
+      pct=$(sed -E 's/.*"splat_fraction": *([^,}]+).*/\1/' <<<"$(tr -d '\n' < $OUT/stats.json)")
+      secs=$(sed -E 's/.*"seconds": *([^,}]+).*/\1/' <<<"$(tr -d '\n' < $OUT/stats.json)")
+      printf "%s\t%s\t%s\t%.2f\t%.4f\t%.1f\t%.2f\n" $vol $d $mode $psnr $ssim \
+          "$(awk "BEGIN{print 100*$pct}")" $secs >> $OUT/fidelity.tsv
+      echo "$vol distance $d $mode: $m"
+    done
+  done
+done
+
+# Markdown: one row per volume and view, PSNR (dB) of each mode, % splats of the hybrid.
+{
+  echo "| volume | view | hybrid | splat | point | hybrid % splats |"
+  echo "|---|---|---|---|---|---|"
+  awk -F'\t' 'NR > 1 { key = $1 "|" $2; psnr[key, $3] = $4; if ($3 == "hybrid") pct[key] = $6;
+                        if (!(key in seen)) { seen[key] = 1; order[n++] = key } }
+              END { for (i = 0; i < n; ++i) { split(order[i], k, "|");
+                      printf "| %s | --distance %s | %s | %s | %s | %s |\n", k[1], k[2],
+                             psnr[order[i], "hybrid"], psnr[order[i], "splat"], psnr[order[i], "point"], pct[order[i]] } }' \
+      $OUT/fidelity.tsv
+} > $OUT/fidelity.md
+cat $OUT/fidelity.md

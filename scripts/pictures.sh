@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# The pictures of docs/fidelity.md and the README: the Engine and the Bonsai in hybrid mode
+# and with --show-primitives (splats red, points in their colour; seed Figure 8a) at the three
+# standard views, 400x400, into out/pictures/. Needs ../shared/volumes (skips what is absent).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/build.sh >/dev/null
+BIN=${BUILD_DIR:-build}/vdbsplat
+OUT=out/pictures
+mkdir -p "$OUT"
+VOLS=../shared/volumes
+declare -A DIMS=([engine]=256,256,128 [bonsai]=256,256,256)
+declare -A TF=([engine]=ct-bone [bonsai]=ct-bone)
+# The Bonsai stands along +y: frame it from the side, slightly above.
+declare -A VIEW=([engine]="" [bonsai]="--view-dir 1,0.35,0.6 --up 0,1,0")
+for vol in engine bonsai; do
+  raw=$(ls $VOLS/${vol}_*.raw.gz 2>/dev/null | head -1 || true)
+  if [[ -z "$raw" ]]; then echo "pictures: no $vol volume under $VOLS, skipping" >&2; continue; fi
+  [[ -f $OUT/$vol.vdb ]] || "$BIN" convert "$raw" -o $OUT/$vol.vdb --dims ${DIMS[$vol]} --type uint8 --threshold 0.1176
+  for d in 8 1 0.35; do
+    "$BIN" render $OUT/$vol.vdb -o $OUT/${vol}_d${d}_hybrid.png --tf ${TF[$vol]} ${VIEW[$vol]} --distance $d -v
+    "$BIN" render $OUT/$vol.vdb -o $OUT/${vol}_d${d}_primitives.png --tf ${TF[$vol]} ${VIEW[$vol]} --distance $d --show-primitives
+  done
+done
+echo "pictures: wrote $(pwd)/$OUT"
