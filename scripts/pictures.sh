@@ -13,6 +13,8 @@ declare -A DIMS=([engine]=256,256,128 [bonsai]=256,256,256)
 declare -A TF=([engine]=ct-bone [bonsai]=ct-bone)
 # The Bonsai stands along +y: frame it from the side, slightly above.
 declare -A VIEW=([engine]="" [bonsai]="--view-dir 1,0.35,0.6 --up 0,1,0")
+# A view where the switch runs through the volume: near voxels splats (red), far ones points.
+declare -A MIXED=([engine]=1.2 [bonsai]=0.7)
 for vol in engine bonsai; do
   raw=$(ls $VOLS/${vol}_*.raw.gz 2>/dev/null | head -1 || true)
   if [[ -z "$raw" ]]; then echo "pictures: no $vol volume under $VOLS, skipping" >&2; continue; fi
@@ -21,5 +23,13 @@ for vol in engine bonsai; do
     "$BIN" render $OUT/$vol.vdb -o $OUT/${vol}_d${d}_hybrid.png --tf ${TF[$vol]} ${VIEW[$vol]} --distance $d -v
     "$BIN" render $OUT/$vol.vdb -o $OUT/${vol}_d${d}_primitives.png --tf ${TF[$vol]} ${VIEW[$vol]} --distance $d --show-primitives
   done
+  "$BIN" render $OUT/$vol.vdb -o $OUT/${vol}_d${MIXED[$vol]}_primitives.png --tf ${TF[$vol]} ${VIEW[$vol]} \
+      --distance ${MIXED[$vol]} --show-primitives -v
 done
+# The README's strip: Engine and Bonsai in hybrid mode, then with --show-primitives where the
+# switch runs through them.
+if [[ -f $OUT/engine_d1_hybrid.png && -f $OUT/bonsai_d0.7_primitives.png ]] && command -v oiiotool >/dev/null; then
+  oiiotool $OUT/engine_d1_hybrid.png $OUT/engine_d1.2_primitives.png $OUT/bonsai_d1_hybrid.png \
+      $OUT/bonsai_d0.7_primitives.png --mosaic 4x1 --resize 960x240 --ch R,G,B -o $OUT/strip.png
+fi
 echo "pictures: wrote $(pwd)/$OUT"
