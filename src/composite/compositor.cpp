@@ -90,37 +90,54 @@ SkippedPrimitives TileCompositor::composite(const std::vector<Primitive>& prims,
     return skipped;
 }
 
-[[gnu::always_inline]] inline void TileCompositor::over(size_t pixel, float tau, const glm::vec3& color) {
-    // α = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α   (DESIGN §4)
-    const float alpha = opacityFromOpticalDepth(tau);
-    float& T = transmittance_[pixel];
-    color_[pixel] += T * alpha * color;
-    T *= 1.f - alpha;
-}
+/// One tile's pixels, row-major with stride kTileSize, in the thread compositing it: the
+/// hot loops touch a few KiB that stay in L1, and the image is written back once per window.
+struct TileCompositor::TilePixels {
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  // inclusive image rectangle of the tile
+    std::array<float, kTileSize * kTileSize> T;
+    std::array<glm::vec3, kTileSize * kTileSize> C;
+
+    static int local(int x, int y, int x0, int y0) { return (y - y0) * kTileSize + (x - x0); }
+    int local(int x, int y) const { return local(x, y, x0, y0); }
+    bool live(int i) const { return T[size_t(i)] >= kTransmittanceEpsilon; }
+    int countLive() const {
+        int n = 0;
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) n += live(local(x, y));
+        return n;
+    }
+    /// α = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α   (DESIGN §4)
+    void over(int i, float tau, const glm::vec3& color) {
+        const float alpha = opacityFromOpticalDepth(tau);
+        float& t = T[size_t(i)];
+        C[size_t(i)] += t * alpha * color;
+        t *= 1.f - alpha;
+    }
+};
 
 void TileCompositor::compositeTile(int tile, std::vector<Entry>& entries, const std::vector<Primitive>& prims) {
     std::sort(entries.begin(), entries.end());
-    const int tx0 = (tile % tilesX_) * kTileSize, ty0 = (tile / tilesX_) * kTileSize;
-    const int tx1 = std::min(width_, tx0 + kTileSize) - 1, ty1 = std::min(height_, ty0 + kTileSize) - 1;
+    TilePixels px;
+    px.x0 = (tile % tilesX_) * kTileSize, px.y0 = (tile / tilesX_) * kTileSize;
+    px.x1 = std::min(width_, px.x0 + kTileSize) - 1, px.y1 = std::min(height_, px.y0 + kTileSize) - 1;
+    for (int y = px.y0; y <= px.y1; ++y)
+        for (int x = px.x0; x <= px.x1; ++x) {
+            px.T[size_t(px.local(x, y))] = transmittance_[size_t(y) * width_ + x];
+            px.C[size_t(px.local(x, y))] = color_[size_t(y) * width_ + x];
+        }
     SlabBuffer slab;
     int64_t slabOf = std::numeric_limits<int64_t>::min();
     const auto flush = [&] {
         if (!slab.dirty) return;
-        for (int y = ty0; y <= ty1; ++y)
-            for (int x = tx0; x <= tx1; ++x) {
-                const int local = (y - ty0) * kTileSize + (x - tx0);
-                const float tau = slab.tau[local];
-                if (tau > 0.f) over(size_t(y) * width_ + x, tau, slab.emission[local] / tau);
-                slab.tau[local] = 0.f;
-                slab.emission[local] = glm::vec3(0.f);
+        for (int y = px.y0; y <= px.y1; ++y)
+            for (int x = px.x0; x <= px.x1; ++x) {
+                const int i = px.local(x, y);
+                const float tau = slab.tau[size_t(i)];
+                if (tau > 0.f) px.over(i, tau, slab.emission[size_t(i)] / tau);
+                slab.tau[size_t(i)] = 0.f;
+                slab.emission[size_t(i)] = glm::vec3(0.f);
             }
         slab.dirty = false;
-    };
-    const auto countLive = [&] {
-        int live = 0;
-        for (int y = ty0; y <= ty1; ++y)
-            for (int x = tx0; x <= tx1; ++x) live += transmittance_[size_t(y) * width_ + x] >= kTransmittanceEpsilon;
-        return live;
     };
     for (size_t e = 0; e < entries.size(); ++e) {
         const Primitive& p = prims[entries[e].index];
@@ -130,76 +147,82 @@ void TileCompositor::compositeTile(int tile, std::vector<Entry>& entries, const 
             slabOf = p.slab;
         }
         // Tile-level early termination, checked every 32 primitives.
-        if ((e & 31) == 31 && !slab.dirty && countLive() == 0) break;
+        if ((e & 31) == 31 && !slab.dirty && px.countLive() == 0) break;
         switch (p.kind) {
-            case PrimitiveKind::Point: drawPoint(p, tx0, ty0, tx1, ty1, slab); break;
-            case PrimitiveKind::Splat: drawSplat(p, tx0, ty0, tx1, ty1); break;
+            case PrimitiveKind::Point: drawPoint(p, px, slab); break;
+            case PrimitiveKind::Splat: drawSplat(p, px); break;
             case PrimitiveKind::SplatExact:
-            case PrimitiveKind::NearEye: drawExact(p, tx0, ty0, tx1, ty1); break;
+            case PrimitiveKind::NearEye: drawExact(p, px); break;
             case PrimitiveKind::Culled: break;
         }
     }
     flush();
-    liveCount_[tile] = countLive();
+    for (int y = px.y0; y <= px.y1; ++y)
+        for (int x = px.x0; x <= px.x1; ++x) {
+            transmittance_[size_t(y) * width_ + x] = px.T[size_t(px.local(x, y))];
+            color_[size_t(y) * width_ + x] = px.C[size_t(px.local(x, y))];
+        }
+    liveCount_[tile] = px.countLive();
 }
 
-void TileCompositor::drawPoint(const Primitive& p, int tx0, int ty0, int tx1, int ty1, SlabBuffer& slab) {
+void TileCompositor::drawPoint(const Primitive& p, const TilePixels& px, SlabBuffer& slab) const {
     const PointFootprint fp = rasterizePoint(pointFilter_, PixelCoord(p.centre), p.variance);
-    const int x0 = std::max(fp.x0, tx0), x1 = std::min(fp.x0 + fp.nx - 1, tx1);
-    const int y0 = std::max(fp.y0, ty0), y1 = std::min(fp.y0 + fp.ny - 1, ty1);
+    const int x0 = std::max(fp.x0, px.x0), x1 = std::min(fp.x0 + fp.nx - 1, px.x1);
+    const int y0 = std::max(fp.y0, px.y0), y1 = std::min(fp.y0 + fp.ny - 1, px.y1);
     for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
-            if (transmittance_[size_t(y) * width_ + x] < kTransmittanceEpsilon) continue;
+            const int i = px.local(x, y);
+            if (!px.live(i)) continue;
             const float tau = p.total * fp.at(x - fp.x0, y - fp.y0);
-            const int local = (y - ty0) * kTileSize + (x - tx0);
-            slab.tau[local] += tau;
-            slab.emission[local] += tau * p.color;
+            slab.tau[size_t(i)] += tau;
+            slab.emission[size_t(i)] += tau * p.color;
         }
     slab.dirty = true;
 }
 
-void TileCompositor::drawSplat(const Primitive& p, int tx0, int ty0, int tx1, int ty1) {
-    const int x0 = std::max(p.range.x0, tx0), x1 = std::min(p.range.x1, tx1);
-    const int y0 = std::max(p.range.y0, ty0), y1 = std::min(p.range.y1, ty1);
+void TileCompositor::drawSplat(const Primitive& p, TilePixels& px) const {
+    const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
+    const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
     const float qxx = p.conic.x, qxy = p.conic.y, qyy = p.conic.z;
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y) + 0.5f - p.centre.y;
         // The row's chord of the support ellipse, i² < 1:  qxx dx² + 2 qxy dy dx + qyy dy² − 1 < 0.
-        // One pixel of slack on each side; the i² test below decides exactly as before.
+        // One pixel of slack on each side; the i² test below decides exactly.
         const float b = qxy * dy, disc = b * b - qxx * (qyy * dy * dy - 1.f);
         if (!(disc > 0.f)) continue;
         const float root = std::sqrt(disc);
         const float lo = p.centre.x - 0.5f + (-b - root) / qxx, hi = p.centre.x - 0.5f + (-b + root) / qxx;
         const int xa = std::max(x0, int(std::floor(lo))), xb = std::min(x1, int(std::ceil(hi)));
+        const int row = (y - px.y0) * kTileSize;
         for (int x = xa; x <= xb; ++x) {
-            const size_t pixel = size_t(y) * width_ + x;
-            if (transmittance_[pixel] < kTransmittanceEpsilon) continue;
+            const int i = row + (x - px.x0);
+            if (!px.live(i)) continue;
             const float dx = float(x) + 0.5f - p.centre.x;
             const float i2 = qxx * dx * dx + 2.f * qxy * dx * dy + qyy * dy * dy;
             if (!(i2 < 1.f)) continue;
-            over(pixel, p.shader.depositAtIndex2(i2), p.color);
+            px.over(i, p.shader.depositAtIndex2(i2), p.color);
         }
     }
 }
 
-void TileCompositor::drawExact(const Primitive& p, int tx0, int ty0, int tx1, int ty1) {
+void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
     const Camera& camera = *exact_.camera;
     const double h = exact_.voxelSize;
     const SphereProjection sphere = projectSphere(camera, ViewPoint(p.viewPos), Kernel::kRadius * h);
     const bool widened = p.kind == PrimitiveKind::SplatExact && sphere.isEllipse();
     ScreenKernel kernel;
     if (widened) kernel = makeScreenKernel(sphere);
-    const int x0 = std::max(p.range.x0, tx0), x1 = std::min(p.range.x1, tx1);
-    const int y0 = std::max(p.range.y0, ty0), y1 = std::min(p.range.y1, ty1);
+    const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
+    const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
     const double sigmaWorld = p.sigma / h;
     for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
-            const size_t pixel = size_t(y) * width_ + x;
-            if (transmittance_[pixel] < kTransmittanceEpsilon) continue;
+            const int i = px.local(x, y);
+            if (!px.live(i)) continue;
             const PixelCoord q(x + 0.5, y + 0.5);
             const double tau = widened ? splatDepositExact(kernel, sphere, sigmaWorld, h, q)
                                        : p.sigma * halfRayFootprint(sphere, q);
-            if (tau > 0.0) over(pixel, float(tau), p.color);
+            if (tau > 0.0) px.over(i, float(tau), p.color);
         }
 }
 

@@ -59,11 +59,11 @@ private:
         bool operator<(const Entry& o) const { return key != o.key ? key < o.key : index < o.index; }
     };
     struct SlabBuffer;
+    struct TilePixels;  // one tile's transmittance and colour, copied in and out (thread-local)
     void compositeTile(int tile, std::vector<Entry>& entries, const std::vector<Primitive>& prims);
-    void drawPoint(const Primitive& p, int tx0, int ty0, int tx1, int ty1, SlabBuffer& slab);
-    void drawSplat(const Primitive& p, int tx0, int ty0, int tx1, int ty1);
-    void drawExact(const Primitive& p, int tx0, int ty0, int tx1, int ty1);
-    void over(size_t pixel, float tau, const glm::vec3& color);
+    void drawPoint(const Primitive& p, const TilePixels& tile, SlabBuffer& slab) const;
+    void drawSplat(const Primitive& p, TilePixels& tile) const;
+    void drawExact(const Primitive& p, TilePixels& tile) const;
 
     int width_, height_, tilesX_, tilesY_;
     const Tables& tables_;
