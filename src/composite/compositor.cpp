@@ -3,6 +3,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
@@ -64,18 +65,29 @@ SkippedPrimitives TileCompositor::composite(const std::vector<Primitive>& prims,
     int64_t slabBase = std::numeric_limits<int64_t>::max();
     for (const Primitive& p : prims)
         if (p.kind != PrimitiveKind::Culled) slabBase = std::min(slabBase, p.slab);
-    SkippedPrimitives skipped;
-    for (auto& bin : bins_) bin.clear();
+    // One global sort by (key, index), then a gather: every tile's list comes out in
+    // order without a per-tile sort, and the tiles read their primitives sequentially
+    // (indexing the window in key order was a cache miss per primitive at far views).
+    order_.clear();
     for (uint32_t i = 0; i < prims.size(); ++i) {
         const Primitive& p = prims[i];
-        if (p.kind == PrimitiveKind::Culled || p.range.empty()) continue;
-        const uint64_t key = sortKey(p, slabBase);
+        if (p.kind != PrimitiveKind::Culled && !p.range.empty()) order_.push_back({sortKey(p, slabBase), i});
+    }
+    tbb::parallel_sort(order_.begin(), order_.end());  // a total order: the result is unique
+    sorted_.resize(order_.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, order_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k < r.end(); ++k) sorted_[k] = prims[order_[k].index];
+    });
+    SkippedPrimitives skipped;
+    for (auto& bin : bins_) bin.clear();
+    for (uint32_t k = 0; k < sorted_.size(); ++k) {
+        const Primitive& p = sorted_[k];
         bool any = false;
         for (int ty = p.range.y0 / kTileSize; ty <= p.range.y1 / kTileSize; ++ty)
             for (int tx = p.range.x0 / kTileSize; tx <= p.range.x1 / kTileSize; ++tx) {
                 const size_t tile = size_t(ty) * tilesX_ + tx;
                 if (liveCount_[tile] == 0) continue;
-                bins_[tile].push_back({key, i});
+                bins_[tile].push_back(k);
                 any = true;
             }
         if (!any) ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
@@ -84,7 +96,7 @@ SkippedPrimitives TileCompositor::composite(const std::vector<Primitive>& prims,
     const auto t1 = Clock::now();
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX_ * tilesY_, 1), [&](const tbb::blocked_range<int>& r) {
         for (int tile = r.begin(); tile < r.end(); ++tile)
-            if (!bins_[tile].empty()) compositeTile(tile, bins_[tile], prims);
+            if (!bins_[tile].empty()) compositeTile(tile, bins_[tile]);
     });
     compositeSeconds += since(t1);
     return skipped;
@@ -115,8 +127,7 @@ struct TileCompositor::TilePixels {
     }
 };
 
-void TileCompositor::compositeTile(int tile, std::vector<Entry>& entries, const std::vector<Primitive>& prims) {
-    std::sort(entries.begin(), entries.end());
+void TileCompositor::compositeTile(int tile, const std::vector<uint32_t>& entries) {
     TilePixels px;
     px.x0 = (tile % tilesX_) * kTileSize, px.y0 = (tile / tilesX_) * kTileSize;
     px.x1 = std::min(width_, px.x0 + kTileSize) - 1, px.y1 = std::min(height_, px.y0 + kTileSize) - 1;
@@ -140,7 +151,7 @@ void TileCompositor::compositeTile(int tile, std::vector<Entry>& entries, const 
         slab.dirty = false;
     };
     for (size_t e = 0; e < entries.size(); ++e) {
-        const Primitive& p = prims[entries[e].index];
+        const Primitive& p = sorted_[entries[e]];
         const bool isPoint = p.kind == PrimitiveKind::Point;
         if (p.slab != slabOf || !isPoint) {
             flush();

@@ -60,7 +60,7 @@ private:
     };
     struct SlabBuffer;
     struct TilePixels;  // one tile's transmittance and colour, copied in and out (thread-local)
-    void compositeTile(int tile, std::vector<Entry>& entries, const std::vector<Primitive>& prims);
+    void compositeTile(int tile, const std::vector<uint32_t>& entries);
     void drawPoint(const Primitive& p, const TilePixels& tile, SlabBuffer& slab) const;
     void drawSplat(const Primitive& p, TilePixels& tile) const;
     void drawExact(const Primitive& p, TilePixels& tile) const;
@@ -72,7 +72,9 @@ private:
     std::vector<glm::vec3> color_;        // premultiplied radiance
     std::vector<float> transmittance_;
     std::vector<int> liveCount_;          // per tile: pixels with T ≥ ε
-    std::vector<std::vector<Entry>> bins_;
+    std::vector<Entry> order_;            // the window's drawable primitives in (key, index) order
+    std::vector<Primitive> sorted_;       // ... gathered in that order
+    std::vector<std::vector<uint32_t>> bins_;  // per tile: positions in sorted_, ascending
 };
 
 }  // namespace vdbsplat

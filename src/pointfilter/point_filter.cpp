@@ -53,14 +53,20 @@ PointFootprint rasterizePoint(const PointFilterTable& table, const PixelCoord& x
     const double rs = std::min(kPointSupportSigmas * std::sqrt(variance), kPointMaxRadiusPx);
     centresWithin(x.x, rs, out.x0, out.nx);
     centresWithin(x.y, rs, out.y0, out.ny);
+    // The Gaussian is separable, exp(−(dx² + dy²)/2V) = exp(−dx²/2V)·exp(−dy²/2V): one table
+    // lookup per column and per row (≤ 14, not ≤ 49); the support stays the circle r < r_s.
     const float invV = static_cast<float>(1.0 / variance), rs2 = static_cast<float>(rs * rs);
+    std::array<float, kPointMaxSide> dxs{}, gx{}, gy{};
+    for (int ix = 0; ix < out.nx; ++ix) {
+        dxs[ix] = static_cast<float>(out.x0 + ix + 0.5 - x.x);
+        gx[ix] = table.weight(dxs[ix] * dxs[ix] * invV);
+    }
     float sum = 0.0f;
     for (int iy = 0; iy < out.ny; ++iy) {
-        const float dy = static_cast<float>(out.y0 + iy + 0.5 - x.y);
+        const float dy = static_cast<float>(out.y0 + iy + 0.5 - x.y), dy2 = dy * dy;
+        gy[iy] = table.weight(dy2 * invV);
         for (int ix = 0; ix < out.nx; ++ix) {
-            const float dx = static_cast<float>(out.x0 + ix + 0.5 - x.x);
-            const float r2 = dx * dx + dy * dy;
-            const float w = r2 < rs2 ? table.weight(r2 * invV) : 0.0f;
+            const float w = dxs[ix] * dxs[ix] + dy2 < rs2 ? gx[ix] * gy[iy] : 0.0f;
             out.w[iy * out.nx + ix] = w;
             sum += w;
         }

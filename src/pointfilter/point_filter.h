@@ -8,7 +8,9 @@
 //     V_point = kPrefilterVariance + (s_g · h·f/z)²            [px²]
 // — exactly the variance of the widened splat kernel of the same voxel on-axis
 // (footprint/screen_kernel.h), so the two converge at the threshold.
-// w is truncated at r_s = min(3·√V_point, 3.5 px) (≤ 7×7 pixel centres) and
+// w is evaluated separably (one 1D table lookup per row and per column: the Gaussian
+// factors) and
+// truncated at r_s = min(3·√V_point, 3.5 px) (≤ 7×7 pixel centres) and
 // renormalised so that its DISCRETE sum over the pixel centres is exactly 1: then
 // the point's total deposit is exactly pointDepositTotal(), whatever its sub-pixel
 // position (the continuous ∫w = 1 would lose ≈ 1.1% to the 3σ truncation).
