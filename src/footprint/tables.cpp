@@ -17,6 +17,7 @@
 
 #include "footprint/kernel.h"
 #include "footprint/reindex.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace vdbsplat {
@@ -167,10 +168,9 @@ std::string readFile(const std::filesystem::path& path) {
     return s.str();
 }
 
+/// Temporary file + rename: an interrupted `tables --out` never leaves a torn table.
 void writeFile(const std::filesystem::path& path, const std::string& bytes) {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!out) throw Error(path.string() + ": cannot write table file");
+    writeTextFileAtomic(path.string(), bytes);
 }
 
 }  // namespace

@@ -227,6 +227,7 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
                       RenderStats& stats) {
     const auto start = std::chrono::steady_clock::now();
     const int n = std::max(1, int(std::ceil(std::sqrt(double(spp)) - 1e-9)));  // strata per axis
+    stats.raysPerPixel = n * n;
     const double sigmaP = std::sqrt(kPrefilterVariance);
     const int border = int(std::ceil(kPrefilterCutoffSigmas * sigmaP));
     const int W = camera.width(), H = camera.height();

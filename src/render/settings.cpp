@@ -56,6 +56,10 @@ nlohmann::json RenderSettings::toJson() const {
         j["up"] = {camera.up.x, camera.up.y, camera.up.z};
     } else {
         j["distance"] = camera.distance;
+        if (camera.hasViewDir) {
+            j["view_dir"] = {camera.viewDir.x, camera.viewDir.y, camera.viewDir.z};
+            j["up"] = {camera.up.x, camera.up.y, camera.up.z};
+        }
     }
     j["tf"] = transferFunction;
     j["grid"] = gridName;
@@ -77,6 +81,7 @@ nlohmann::json RenderStats::toJson() const {
     const uint64_t drawn = points + splats;
     j["splat_fraction"] = drawn ? double(splats) / double(drawn) : 0.0;
     if (rays) j["rays"] = rays;
+    if (raysPerPixel) j["rays_per_pixel"] = raysPerPixel;
     j["stage_seconds"] = {{"stream", streamSeconds}, {"project", projectSeconds},
                           {"rasterize", rasterizeSeconds}, {"composite", compositeSeconds}};
     return j;

@@ -40,6 +40,7 @@ struct RenderStats {
     uint64_t points = 0, splats = 0;  ///< primitives drawn (not hidden behind opaque tiles)
     uint64_t culled = 0;              ///< active voxels that drew nothing (frustum, occlusion, off screen, σ = 0)
     uint64_t rays = 0;  ///< reference: rays traced
+    int raysPerPixel = 0;  ///< reference: the --spp actually used (rounded up to a square)
     double streamSeconds = 0.0, projectSeconds = 0.0, rasterizeSeconds = 0.0, compositeSeconds = 0.0;
     nlohmann::json toJson() const;
 };

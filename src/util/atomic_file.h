@@ -1,4 +1,4 @@
-// util/atomic_file.h — writing small text outputs (JSON stats) without ever
+// util/atomic_file.h — writing whole files (JSON stats, tables) without ever
 // leaving a partial file: write a temporary file beside the target, rename it.
 #pragma once
 #include <string>

@@ -37,10 +37,10 @@ inline constexpr uint64_t kDefaultCloudActive = 1'000'000, kDefaultCloudSeed = 1
 
 /// @brief What to generate; unset fields take the kind's default in validate().
 struct GenerateOptions {
-    std::string kind;               ///< checkerbox | marschner-lobb | sphere | cloud
-    std::optional<int> res;         ///< grid side in voxels (not for cloud)
-    std::optional<uint64_t> active; ///< cloud only: target active voxel count
-    std::optional<uint64_t> seed;   ///< cloud only: noise seed
+    std::string kind{};             ///< checkerbox | marschner-lobb | sphere | cloud
+    std::optional<int> res{};       ///< grid side in voxels (not for cloud)
+    std::optional<uint64_t> active{}; ///< cloud only: target active voxel count
+    std::optional<uint64_t> seed{};   ///< cloud only: noise seed
 
     /// @brief Fills in defaults and checks the combination (messages name the flag).
     /// @throw Error for an unknown kind, a flag the kind does not use, or sizes out of bounds.

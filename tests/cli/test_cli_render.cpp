@@ -430,6 +430,30 @@ TEST_F(CliRender, StatsJsonHasCountsTimingsAndSettings) {
     EXPECT_EQ(listDir(d / "out"), (std::vector<std::string>{"img.png", "s.json"}));
 }
 
+TEST_F(CliRender, StatsJsonRecordsTheFramingAndTheRaysUsed) {
+    const fs::path d = runDir("stats-framing");
+    const fs::path stats = d / "s.json";
+    Result r = runBinary(renderArgs(vdb("sphere.vdb"), (d / "a.png").string(), "hybrid",
+                                    {"--size", "16x16", "--view-dir", "1,0,0", "--up", "0,0,1", "--stats",
+                                     stats.string()}),
+                         d / "log");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    nlohmann::json j = nlohmann::json::parse(slurp(stats));
+    ASSERT_TRUE(j.contains("view_dir")) << j.dump();
+    EXPECT_EQ(j["view_dir"], nlohmann::json({1.0, 0.0, 0.0}));
+    EXPECT_EQ(j["up"], nlohmann::json({0.0, 0.0, 1.0}));
+    EXPECT_FALSE(j.contains("rays_per_pixel")) << "forward modes trace no rays";
+
+    r = runBinary(renderArgs(vdb("sphere.vdb"), (d / "b.png").string(), "reference",
+                             {"--size", "8x8", "--spp", "5", "--stats", stats.string()}),
+                  d / "log");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    j = nlohmann::json::parse(slurp(stats));
+    EXPECT_EQ(j["spp"], 5) << "the setting as given";
+    EXPECT_EQ(j["rays_per_pixel"], 9) << "rounded up to a square: 3x3 strata";
+    EXPECT_FALSE(j.contains("view_dir"));
+}
+
 TEST_F(CliRender, ImageIndependentOfThreadsAndOfTablesSource) {
     // 32x32 hybrid: a mix of points and splats (checked in StatsJsonHasCountsTimingsAndSettings).
     const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {

@@ -52,7 +52,9 @@ protected:
         EXPECT_EQ(r.err.rfind("vdbsplat: error: ", 0), 0u) << args << "\n" << r.err;
         EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
         EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\nexpected '" << needle << "' in: " << r.err;
-        if (!output.empty()) EXPECT_FALSE(fs::exists(output)) << args;
+        if (!output.empty()) {
+            EXPECT_FALSE(fs::exists(output)) << args;
+        }
         for (const auto& e : fs::directory_iterator(dir_))  // no temporary left behind either
             EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
     }

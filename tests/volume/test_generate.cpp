@@ -94,7 +94,9 @@ TEST(Generate, SphereMatchesBruteForce) {
                 const bool inside = q < 1.0;
                 expected += inside;
                 ASSERT_EQ(acc.isValueOn(Coord(i, j, k)), inside);
-                if (inside) ASSERT_NEAR(acc.getValue(Coord(i, j, k)), (1 - q) * (1 - q), 1e-6);
+                if (inside) {
+                    ASSERT_NEAR(acc.getValue(Coord(i, j, k)), (1 - q) * (1 - q), 1e-6);
+                }
             }
     EXPECT_EQ(grid->activeVoxelCount(), expected);
     EXPECT_EQ(grid->evalActiveVoxelBoundingBox(), CoordBBox(Coord(1), Coord(res - 2)));

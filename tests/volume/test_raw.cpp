@@ -84,7 +84,9 @@ TEST_F(Raw, Uint8LayoutIsXFastestAndNormalised) {
                 const unsigned char v = data[x + X * (y + Y * z)];
                 nonzero += v > 0;
                 ASSERT_EQ(acc.isValueOn(Coord(x, y, z)), v > 0) << x << "," << y << "," << z;
-                if (v) ASSERT_FLOAT_EQ(acc.getValue(Coord(x, y, z)), v / 255.0f);
+                if (v) {
+                    ASSERT_FLOAT_EQ(acc.getValue(Coord(x, y, z)), v / 255.0f);
+                }
             }
     EXPECT_EQ(grid->activeVoxelCount(), nonzero);
     EXPECT_EQ(stats.active, nonzero);
