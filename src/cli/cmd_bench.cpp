@@ -55,7 +55,7 @@ const char* kHelp =
     "  --view-dir X,Y,Z     framing direction, centre to eye (default 0.9,-1.3,0.75)\n"
     "  --up X,Y,Z           up vector (default 0,0,1)\n"
     "  --threshold PX       minification threshold of hybrid mode in pixels (default 1)\n"
-    "  --footprint P        table (default) | exact\n"
+    "  --footprint P        auto (default) | table | exact (see render --help)\n"
     "  --json FILE.json     also write every run, the per-stage medians and the ratios as JSON\n"
     "  -v                   print each run to stderr and the per-stage medians to stdout\n";
 
@@ -137,11 +137,7 @@ Options optionsFrom(const Args& args) {
     if (auto v = args.get("--grid")) s.gridName = *v;
     if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
-    if (auto v = args.get("--footprint")) {
-        if (*v == "table") s.footprint = FootprintPath::Table;
-        else if (*v == "exact") s.footprint = FootprintPath::Exact;
-        else throw Error("--footprint: expected 'table' or 'exact', got '" + *v + "'");
-    }
+    if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
     if (auto v = args.get("--view-dir")) {
         const auto d = parseDoubleList(*v, "--view-dir", 3);
         s.camera.hasViewDir = true;
@@ -284,7 +280,7 @@ int runBench(const Argv& argv) {
     std::printf("vdbsplat bench: %s (grid '%s', %llu active voxels), %dx%d, tf %s, threshold %g px, footprint %s\n",
                 o.input.c_str(), volume.name.c_str(), (unsigned long long)volume.activeVoxels, o.base.camera.width,
                 o.base.camera.height, o.base.transferFunction.c_str(), o.base.threshold,
-                o.base.footprint == FootprintPath::Table ? "table" : "exact");
+                toString(o.base.footprint).c_str());
     std::printf("threads %d (machine %u), %d timed run%s + %d warmup per view and mode, interleaved\n\n", threads,
                 machine, o.runs, o.runs == 1 ? "" : "s", o.warmup);
     std::printf("%8s  %-9s  %9s  %9s  %8s  %15s  %10s  %10s  %10s\n", "distance", "mode", "median_s", "min_s", "%splats",
@@ -332,7 +328,7 @@ int runBench(const Argv& argv) {
         j["warmup"] = o.warmup;
         j["tf"] = o.base.transferFunction;
         j["threshold"] = o.base.threshold;
-        j["footprint"] = o.base.footprint == FootprintPath::Table ? "table" : "exact";
+        j["footprint"] = toString(o.base.footprint);
         j["fov"] = o.base.camera.fovDeg;
         nlohmann::ordered_json results = nlohmann::ordered_json::array();
         for (const Cell& c : cells) {

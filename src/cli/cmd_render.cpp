@@ -36,7 +36,9 @@ const char* kHelp =
     "  --fov DEG          vertical field of view (default 30)\n"
     "  --distance K       multiplies the framing distance (8 far, 1 framed, 0.35 close)\n"
     "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
-    "  --footprint P      table (default) | exact: per-pixel ray-centre distance instead of the (i, alpha) table\n"
+    "  --footprint P      auto (default): the (i, alpha) reindex table, and the exact ray-centre\n"
+    "                     distance for splats far off the axis where the affine index is off;\n"
+    "                     table: the reindex table for every splat; exact: closed form per pixel\n"
     "  --show-primitives  tint splats red, points keep their colour\n"
     "  --tables DIR       footprint.table and reindex.table from DIR (default: the shipped tables/);\n"
     "                     a file absent from DIR is built in memory, a corrupt one or one built for\n"
@@ -62,11 +64,7 @@ RenderSettings settingsFrom(const Args& args) {
     if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
     if (auto v = args.get("--spp")) s.spp = int(parseInt(*v, "--spp", 1, 1024));
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
-    if (auto v = args.get("--footprint")) {
-        if (*v == "table") s.footprint = FootprintPath::Table;
-        else if (*v == "exact") s.footprint = FootprintPath::Exact;
-        else throw Error("--footprint: expected 'table' or 'exact', got '" + *v + "'");
-    }
+    if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
     s.showPrimitives = args.has("--show-primitives");
     if (auto v = args.get("--tables")) {
         if (v->empty()) throw Error("--tables: expected a directory, got ''");

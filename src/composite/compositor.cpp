@@ -90,7 +90,10 @@ SkippedPrimitives TileCompositor::composite(const std::vector<Primitive>& prims,
                 bins_[tile].push_back(k);
                 any = true;
             }
-        if (!any) ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
+        if (!any) {
+            ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
+            if (p.kind == PrimitiveKind::SplatExactIndex) ++skipped.exactIndexSplats;
+        }
     }
     binSeconds += since(t0);
     const auto t1 = Clock::now();
@@ -161,7 +164,8 @@ void TileCompositor::compositeTile(int tile, const std::vector<uint32_t>& entrie
         if ((e & 31) == 31 && !slab.dirty && px.countLive() == 0) break;
         switch (p.kind) {
             case PrimitiveKind::Point: drawPoint(p, px, slab); break;
-            case PrimitiveKind::Splat: drawSplat(p, px); break;
+            case PrimitiveKind::Splat:
+            case PrimitiveKind::SplatExactIndex: drawSplat(p, px); break;
             case PrimitiveKind::SplatExact:
             case PrimitiveKind::NearEye: drawExact(p, px); break;
             case PrimitiveKind::Culled: break;
@@ -192,6 +196,16 @@ void TileCompositor::drawPoint(const Primitive& p, const TilePixels& px, SlabBuf
 }
 
 void TileCompositor::drawSplat(const Primitive& p, TilePixels& px) const {
+    // SplatExactIndex (--footprint auto, far off the axis): the exact index d instead of the
+    // affine one, as an affine map set up once per tile from the kernel's view position.
+    const bool exactIndex = p.kind == PrimitiveKind::SplatExactIndex;
+    ExactIndexMap map;
+    if (exactIndex) {
+        const SphereProjection sphere =
+            projectSphere(*exact_.camera, ViewPoint(p.viewPos), Kernel::kRadius * exact_.voxelSize);
+        if (!sphere.isEllipse()) return drawExact(p, px);  // borderline in float: the half-ray fallback
+        map = makeExactIndexMap(makeScreenKernel(sphere), sphere, PixelCoord(p.centre));
+    }
     const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
     const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
     const float qxx = p.conic.x, qxy = p.conic.y, qyy = p.conic.z;
@@ -211,7 +225,9 @@ void TileCompositor::drawSplat(const Primitive& p, TilePixels& px) const {
             const float dx = float(x) + 0.5f - p.centre.x;
             const float i2 = qxx * dx * dx + 2.f * qxy * dx * dy + qyy * dy * dy;
             if (!(i2 < 1.f)) continue;
-            px.over(i, p.shader.depositAtIndex2(i2), p.color);
+            const float tau = exactIndex ? p.shader.depositAtD2(map.d2(dx, dy))
+                                         : p.shader.depositAtIndex2(i2);
+            px.over(i, tau, p.color);
         }
     }
 }
@@ -220,7 +236,9 @@ void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
     const Camera& camera = *exact_.camera;
     const double h = exact_.voxelSize;
     const SphereProjection sphere = projectSphere(camera, ViewPoint(p.viewPos), Kernel::kRadius * h);
-    const bool widened = p.kind == PrimitiveKind::SplatExact && sphere.isEllipse();
+    // Recomputed from the float view position: a borderline sphere may no longer be an
+    // Ellipse, and then takes the half-ray fallback like a NearEye kernel.
+    const bool widened = p.kind != PrimitiveKind::NearEye && sphere.isEllipse();
     ScreenKernel kernel;
     if (widened) kernel = makeScreenKernel(sphere);
     const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
@@ -231,8 +249,8 @@ void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
             const int i = px.local(x, y);
             if (!px.live(i)) continue;
             const PixelCoord q(x + 0.5, y + 0.5);
-            const double tau = widened ? splatDepositExact(kernel, sphere, sigmaWorld, h, q)
-                                       : p.sigma * halfRayFootprint(sphere, q);
+            const double tau =
+                widened ? splatDepositExact(kernel, sphere, sigmaWorld, h, q) : p.sigma * halfRayFootprint(sphere, q);
             if (tau > 0.0) px.over(i, float(tau), p.color);
         }
 }

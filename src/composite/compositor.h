@@ -36,6 +36,7 @@ struct ExactContext {
 /// Primitives composite() dropped because every tile they touch is already opaque.
 struct SkippedPrimitives {
     uint64_t points = 0, splats = 0;
+    uint64_t exactIndexSplats = 0;  ///< of the splats: SplatExactIndex
 };
 
 class TileCompositor {

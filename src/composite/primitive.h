@@ -18,6 +18,8 @@ enum class PrimitiveKind : uint8_t {
     Point = 1,     ///< minified voxel: w(p − centre) with variance `variance`, total optical depth `total`
     Splat = 2,     ///< magnified voxel, table path: conic + SplatShader
     SplatExact = 3,///< magnified voxel, --footprint exact: recomputed per tile from viewPos
+    SplatExactIndex = 5, ///< magnified voxel, --footprint auto, far off-axis: exact index d per pixel
+                         ///< (kernel recomputed per tile from viewPos) into the footprint table
     NearEye = 4,   ///< kernel containing the eye or straddling the eye plane: exact half-ray integral
 };
 

@@ -100,6 +100,11 @@ double SphereProjection::index2(const PixelCoord& p) const {
 
 double SphereProjection::index(const PixelCoord& p) const { return std::sqrt(index2(p)); }
 
+double SphereProjection::affineIndexError() const {
+    if (kind != SphereClass::Ellipse) return std::numeric_limits<double>::infinity();
+    return std::tan(theta) * std::tan(alpha);
+}
+
 glm::dvec3 pixelRay(const SphereProjection& s, const PixelCoord& p) {
     return {(p.x - s.principal.x) / s.f, -(p.y - s.principal.y) / s.f, 1.0};
 }

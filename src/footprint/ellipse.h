@@ -52,6 +52,10 @@ struct SphereProjection {
     double index2(const PixelCoord& p) const;
     /// @brief i(p) = sqrt(index2(p)).
     double index(const PixelCoord& p) const;
+    /// @brief tanθ·tanα: the measured max |d(i(p), α) − d_exact(p)| of the affine index over
+    /// the ellipse, to within 15 % (docs/footprint.md; the footprint's error is ≈ 1.7× this,
+    /// relative to its peak). 0 on the axis; +infinity for a sphere that is not an Ellipse.
+    double affineIndexError() const;
 };
 
 /// @brief Projects the sphere of radius @p r centred at view point @p c through a

@@ -59,6 +59,19 @@ double exactIndexD2(const ScreenKernel& k, const SphereProjection& e, const Pixe
     return exactRayDistance2(e, k.centre + k.pullback * (p - k.centre));
 }
 
+ExactIndexMap makeExactIndexMap(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& origin) {
+    // p' = k.centre + S·(p − k.centre) = [k.centre + S·(origin − k.centre)] + S·δ, and
+    // pixelRay(p') = ((p'.x − pp.x)/f, −(p'.y − pp.y)/f, 1) is affine in p'.
+    const glm::dvec3 v0 = pixelRay(e, k.centre + k.pullback * (origin - k.centre));
+    const glm::dvec3 vx(k.pullback[0].x / e.f, -k.pullback[0].y / e.f, 0.0);  // S·(1, 0) = column 0
+    const glm::dvec3 vy(k.pullback[1].x / e.f, -k.pullback[1].y / e.f, 0.0);
+    ExactIndexMap m;
+    m.v0 = glm::vec3(v0), m.vx = glm::vec3(vx), m.vy = glm::vec3(vy);
+    m.A = glm::vec3(glm::cross(e.c, v0)), m.B = glm::vec3(glm::cross(e.c, vx)), m.C = glm::vec3(glm::cross(e.c, vy));
+    m.invR2 = float(1.0 / (e.r * e.r));
+    return m;
+}
+
 double splatDepositExact(const ScreenKernel& k, const SphereProjection& e, double sigma, double h,
                          const PixelCoord& p) {
     const double d2 = exactIndexD2(k, e, p);

@@ -80,6 +80,27 @@ double splatDeposit(const ScreenKernel& k, const SplatShader& shader, const Pixe
 /// of the table path.
 double exactIndexD2(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& p);
 
+/// @brief exactIndexD2 as an affine map of the pixel, for hot loops (--footprint auto).
+/// With δ = p − origin, the ray through the pulled-back pixel is v = v0 + δx·vx + δy·vy
+/// (pixelRay is affine in the pixel, and so is the pullback), hence c × v = A + δx·B + δy·C
+/// and d² = |c × v|² / (|v|²·r²) (DESIGN §3) costs about 20 float operations per pixel.
+/// The six vectors are formed in double; every term is O(α) and none cancels badly, so d
+/// stays within ~1e−6 of exactIndexD2 (ScreenKernel.ExactIndexMapMatchesExactIndexD2).
+/// It does not test the support: callers use the conic (i² < 1) as the table path does.
+struct ExactIndexMap {
+    glm::vec3 v0{0.f}, vx{0.f}, vy{0.f};  ///< ray of the pulled-back pixel: v0 + δx·vx + δy·vy
+    glm::vec3 A{0.f}, B{0.f}, C{0.f};     ///< c × v0, c × vx, c × vy
+    float invR2 = 0.f;                    ///< 1 / r²
+
+    float d2(float dx, float dy) const {
+        const glm::vec3 w = A + dx * B + dy * C, v = v0 + dx * vx + dy * vy;
+        return glm::dot(w, w) / (glm::dot(v, v)) * invR2;
+    }
+};
+
+/// @brief The ExactIndexMap of kernel @p k of Ellipse @p e, with δ measured from @p origin.
+ExactIndexMap makeExactIndexMap(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& origin);
+
 /// @brief τ at @p p on the EXACT path. "Exact" for the widened kernel means: pull p back
 /// to the unwidened geometric ellipse, p' = centre + S·(p − centre) (same unit-disk
 /// coordinates), and use the exact ray–centre distance of p' instead of the affine index

@@ -32,11 +32,13 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
         for (const Primitive& p : prims) {
             if (p.kind == PrimitiveKind::Point) ++stats.points;
             else if (p.kind != PrimitiveKind::Culled) ++stats.splats;
+            if (p.kind == PrimitiveKind::SplatExactIndex) ++stats.exactIndexSplats;
         }
         stats.projectSeconds += since(t);
         const SkippedPrimitives hiddenPrims = compositor.composite(prims, stats.rasterizeSeconds, stats.compositeSeconds);
         stats.points -= hiddenPrims.points;
         stats.splats -= hiddenPrims.splats;
+        stats.exactIndexSplats -= hiddenPrims.exactIndexSplats;
     }
     // Everything else drew nothing: outside the frustum, behind opaque tiles, off screen,
     // or transparent under the transfer function.

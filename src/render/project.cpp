@@ -53,7 +53,10 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
             break;
         case SphereClass::Ellipse: {
             const ScreenKernel kernel = makeScreenKernel(sphere);
-            p.kind = ctx.footprint == FootprintPath::Exact ? PrimitiveKind::SplatExact : PrimitiveKind::Splat;
+            p.kind = ctx.footprint == FootprintPath::Exact ? PrimitiveKind::SplatExact
+                     : ctx.footprint == FootprintPath::Auto && sphere.affineIndexError() > kAutoExactIndexError
+                         ? PrimitiveKind::SplatExactIndex
+                         : PrimitiveKind::Splat;
             p.centre = glm::vec2(kernel.centre);
             p.conic = glm::vec3(kernel.conic[0][0], kernel.conic[0][1], kernel.conic[1][1]);
             p.shader = makeSplatShader(kernel, ctx.tables, sigma / h, h);

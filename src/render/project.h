@@ -15,6 +15,11 @@
 
 namespace vdbsplat {
 
+/// --footprint auto: splats whose affine index may be off by more than this (in d, the
+/// normalised ray–centre distance; SphereProjection::affineIndexError) take the exact index.
+/// 5e−4 in d is ≈ 1e−3 of the footprint's peak, 12× the footprint table's own error.
+inline constexpr double kAutoExactIndexError = 5e-4;
+
 struct ProjectionContext {
     const Camera& camera;
     const Tables& tables;

@@ -44,6 +44,22 @@ void RenderSettings::validate() const {
     }
 }
 
+FootprintPath parseFootprintPath(const std::string& name) {
+    if (name == "auto") return FootprintPath::Auto;
+    if (name == "table") return FootprintPath::Table;
+    if (name == "exact") return FootprintPath::Exact;
+    throw Error("--footprint: expected 'auto', 'table' or 'exact', got '" + name + "'");
+}
+
+std::string toString(FootprintPath path) {
+    switch (path) {
+        case FootprintPath::Table: return "table";
+        case FootprintPath::Auto: return "auto";
+        case FootprintPath::Exact: return "exact";
+    }
+    return "?";
+}
+
 nlohmann::json RenderSettings::toJson() const {
     nlohmann::json j;
     j["mode"] = toString(mode);
@@ -65,7 +81,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["grid"] = gridName;
     j["spp"] = spp;
     j["threshold"] = threshold;
-    j["footprint"] = footprint == FootprintPath::Table ? "table" : "exact";
+    j["footprint"] = toString(footprint);
     j["show_primitives"] = showPrimitives;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
     return j;
@@ -78,6 +94,7 @@ nlohmann::json RenderStats::toJson() const {
     j["points"] = points;
     j["splats"] = splats;
     j["culled"] = culled;
+    j["splats_exact_index"] = exactIndexSplats;
     const uint64_t drawn = points + splats;
     j["splat_fraction"] = drawn ? double(splats) / double(drawn) : 0.0;
     if (rays) j["rays"] = rays;

@@ -11,7 +11,17 @@
 namespace vdbsplat {
 
 enum class RenderMode { Reference, Hybrid, Splat, Point };
-enum class FootprintPath { Table, Exact };
+/// How a splat's footprint index is found (DESIGN §3, docs/footprint.md):
+///   Table — affine ellipse→circle index i, then the (i, α) reindex table (the seed's method);
+///   Auto  — Table, except splats whose affine-index error tanθ·tanα exceeds
+///           kAutoExactIndexError (large, near, off-axis kernels) use the exact per-pixel
+///           ray–centre distance; both then read the pre-integrated footprint table;
+///   Exact — every splat by the closed-form per-pixel footprint (to measure the others).
+enum class FootprintPath { Table, Auto, Exact };
+
+/// @throw Error "--footprint: expected 'auto', 'table' or 'exact', got '<name>'".
+FootprintPath parseFootprintPath(const std::string& name);
+std::string toString(FootprintPath path);
 
 /// @throw Error "unknown mode '<name>' (choose hybrid, splat, point, reference)".
 RenderMode parseRenderMode(const std::string& name);
@@ -25,7 +35,7 @@ struct RenderSettings {
     int threads = 0;                        ///< 0: all cores
     int spp = 16;                           ///< reference: rays per pixel (rounded to a square)
     double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
-    FootprintPath footprint = FootprintPath::Table;
+    FootprintPath footprint = FootprintPath::Auto;
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
     std::string tablesDir;                  ///< footprint/reindex tables; empty: defaultTablesDir()
 
@@ -38,6 +48,7 @@ struct RenderStats {
     double seconds = 0.0;
     uint64_t activeVoxels = 0;
     uint64_t points = 0, splats = 0;  ///< primitives drawn (not hidden behind opaque tiles)
+    uint64_t exactIndexSplats = 0;    ///< of the splats: drawn with the exact index (--footprint auto)
     uint64_t culled = 0;              ///< active voxels that drew nothing (frustum, occlusion, off screen, σ = 0)
     uint64_t rays = 0;  ///< reference: rays traced
     int raysPerPixel = 0;  ///< reference: the --spp actually used (rounded up to a square)

@@ -416,6 +416,9 @@ TEST_F(CliRender, StatsJsonHasCountsTimingsAndSettings) {
     EXPECT_EQ(j["height"], 32);
     EXPECT_EQ(j["grid"], "density");
     EXPECT_EQ(j["tables"], "");
+    EXPECT_EQ(j["footprint"], "auto") << "the default footprint path";
+    EXPECT_GE(j["splats_exact_index"].get<double>(), 0.0);
+    EXPECT_LE(j["splats_exact_index"].get<double>(), j["splats"].get<double>());
     EXPECT_GT(j["active_voxels"].get<double>(), 1000.0);
     EXPECT_GE(j["seconds"].get<double>(), 0.0);
     EXPECT_GT(j["points"].get<double>(), 0.0);  // this view has both kinds

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <numbers>
 
@@ -206,6 +207,8 @@ TEST(Ellipse, HalfRayFootprintEqualsFullFootprintForEllipses) {
 /// This measures max |reindex(i(p), α) − d_exact(p)| over the ellipse and REPORTS it.
 TEST(Ellipse, AffineIndexErrorOffAxisIsMeasuredAndReported) {
     std::printf("affine-index error max|d(i(p),α) − d_exact(p)| over the ellipse (and in F, relative to F(0)):\n");
+    EXPECT_EQ(projectSphere(ViewPoint(0.0, 0.0, 0.5), 1.0, 100.0, {0.0, 0.0}).affineIndexError(),
+              std::numeric_limits<double>::infinity()) << "no ellipse, no affine index";
     std::printf("  theta\\alpha ");
     const double alphas[] = {0.5, 2.0, 5.0, 15.0, 30.0};
     for (double a : alphas) std::printf("%16.1f°", a);
@@ -239,7 +242,12 @@ TEST(Ellipse, AffineIndexErrorOffAxisIsMeasuredAndReported) {
             if (theta == 0.0) {
                 EXPECT_LT(worstD, 1e-9) << "the affine index must be exact on-axis";
             }
-            EXPECT_LT(worstD, 2.0 * std::tan(theta * kDeg) * std::tan(alpha * kDeg) + 1e-6);
+            // SphereProjection::affineIndexError() (tanθ·tanα) is what --footprint auto
+            // thresholds: it must track the measured error within 20 % both ways.
+            const double estimate = s.affineIndexError();
+            EXPECT_NEAR(estimate, std::tan(theta * kDeg) * std::tan(alpha * kDeg), 1e-12);
+            EXPECT_LE(worstD, 1.2 * estimate + 1e-9) << "theta " << theta << " alpha " << alpha;
+            EXPECT_GE(worstD, 0.8 * estimate - 1e-9) << "theta " << theta << " alpha " << alpha;
         }
         std::printf("\n");
     }

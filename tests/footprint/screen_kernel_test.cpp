@@ -125,6 +125,44 @@ TEST(ScreenKernel, FastExactPathMatchesClosedFormExactPathOffAxis) {
     EXPECT_GT(worstTable, 10.0 * worstFast);  // the affine index is the dominant error off-axis
 }
 
+// The compositor's float, affine form of the exact index against the double exactIndexD2,
+// from near the axis to far off it, small and large kernels, near and far.
+TEST(ScreenKernel, ExactIndexMapMatchesExactIndexD2) {
+    struct Case {
+        ViewPoint c;
+        double r, f;
+    };
+    const Case cases[] = {
+        {{2.5, 1.0, 6.0}, 1.2, 300.0},      // θ ≈ 24°, α ≈ 10°
+        {{-40.0, 25.0, 90.0}, 2.0, 500.0},  // θ ≈ 28°, α ≈ 1°
+        {{0.3, -0.2, 4.0}, 2.0, 150.0},     // near the axis, α = 30°
+        {{150.0, 80.0, 400.0}, 2.0, 1000.0},// far: α ≈ 0.26°, spacing ≈ 2 px
+    };
+    for (const Case& cs : cases) {
+        const SphereProjection e = projectSphere(cs.c, cs.r, cs.f, {200.0, 200.0});
+        ASSERT_EQ(e.kind, SphereClass::Ellipse);
+        const ScreenKernel k = makeScreenKernel(e);
+        const PixelCoord origin = glm::dvec2(glm::vec2(k.centre));  // the float centre, as the compositor has it
+        const ExactIndexMap map = makeExactIndexMap(k, e, origin);
+        double worst = 0.0;
+        int inside = 0;
+        const PixelRange range = pixelRange(k.bounds);
+        for (int y = range.y0; y <= range.y1; ++y)
+            for (int x = range.x0; x <= range.x1; ++x) {
+                const PixelCoord p(x + 0.5, y + 0.5);
+                const double d2 = exactIndexD2(k, e, p);
+                if (!(d2 < 1.0)) continue;
+                ++inside;
+                const float fast = map.d2(float(p.x - origin.x), float(p.y - origin.y));
+                worst = std::max(worst, std::abs(std::sqrt(double(fast)) - std::sqrt(d2)));
+            }
+        std::printf("  theta %5.1f° alpha %5.2f°: %5d pixels, max |d_map − d_exact| = %.2e\n",
+                    e.theta * 180.0 / std::numbers::pi, e.alpha * 180.0 / std::numbers::pi, inside, worst);
+        EXPECT_GT(inside, 3);
+        EXPECT_LT(worst, 2e-6);
+    }
+}
+
 TEST(ScreenKernel, NonEllipsesAreRefused) {
     EXPECT_THROW(makeScreenKernel(projectSphere({0.0, 0.0, 0.5}, 1.0, 100.0, {0.0, 0.0})), std::invalid_argument);
     EXPECT_THROW(makeScreenKernel(projectSphere({3.0, 0.0, 0.5}, 1.0, 100.0, {0.0, 0.0})), std::invalid_argument);

@@ -198,6 +198,7 @@ TEST(Forward, OnAxisCloseUpSplatsMatchTheReference) {
     for (const double fov : {20.0, 60.0}) {
         RenderSettings s = lookingAt(RenderMode::Splat, {0.0, 0.0, -4.0}, {0.0, 0.0, 2.0}, fov);
         s.spp = 16;
+        s.footprint = FootprintPath::Table;  // the (i, α) reindex table, whatever the default
         RenderSettings r = s;
         r.mode = RenderMode::Reference;
         const Image reference = renderWith(line, tf, r);
@@ -225,13 +226,60 @@ TEST(Forward, OffAxisCloseUpTableErrorIsBoundedAndExactPathIsNot) {
             r.mode = RenderMode::Reference;
             const Image reference = renderWith(box, tf, r);
             EXPECT_GT(centreMean(reference).w, 0.5);  // the box fills the view centre
+            s.footprint = FootprintPath::Table;
             const double table = psnrOf("close-up table", box, tf, s, reference);
             s.footprint = FootprintPath::Exact;
             const double exact = psnrOf("close-up exact", box, tf, s, reference);
+            s.footprint = FootprintPath::Auto;
+            RenderStats stats;
+            const double autoPsnr = compareImages(renderWith(box, tf, s, &stats), reference).psnr;
+            std::printf("  close-up auto: PSNR %6.2f dB, %llu of %llu splats with the exact index\n", autoPsnr,
+                        (unsigned long long)stats.exactIndexSplats, (unsigned long long)stats.splats);
             EXPECT_GE(table, 28.0);
             EXPECT_GE(exact, 60.0);
             EXPECT_GT(exact, table + 20.0);
+            // auto: exact index where the affine one is off, footprint from the table.
+            EXPECT_GT(stats.exactIndexSplats, 0u);
+            EXPECT_GT(autoPsnr, table + 20.0);
+            EXPECT_GE(autoPsnr, 60.0);
         }
+}
+
+// --footprint auto takes the exact index exactly where the affine one is off (tanθ·tanα above
+// kAutoExactIndexError), and is the table path everywhere else, to the bit.
+TEST(Forward, AutoFootprintTakesTheExactIndexOnlyOffAxis) {
+    const Volume voxel = boxVolume({0, 0, 0}, {0, 0, 0});
+    const TransferFunction tf = constantTf(0.5f);
+    struct View {
+        const char* what;
+        glm::dvec3 eye, lookAt;
+        bool exactIndex;
+    };
+    const View views[] = {
+        {"close, on the axis (θ = 0)", {0, 0, -6}, {0, 0, 0}, false},
+        {"far, slightly off the axis (tanθ·tanα ≈ 3e-5)", {0, 0, -600}, {5, 0, 0}, false},
+        {"close, off the axis (tanθ·tanα ≈ 0.09)", {0, 0, -6}, {1.5, 0, 0}, true},
+    };
+    for (const View& v : views) {
+        RenderSettings s = lookingAt(RenderMode::Splat, v.eye, v.lookAt);
+        RenderStats stats;
+        s.footprint = FootprintPath::Auto;
+        const Image autoImage = renderWith(voxel, tf, s, &stats);
+        s.footprint = FootprintPath::Table;
+        const Image tableImage = renderWith(voxel, tf, s);
+        s.footprint = FootprintPath::Exact;
+        const Image exactImage = renderWith(voxel, tf, s);
+        ASSERT_EQ(stats.splats, 1u) << v.what;
+        EXPECT_EQ(stats.exactIndexSplats, v.exactIndex ? 1u : 0u) << v.what;
+        const double toTable = compareImages(autoImage, tableImage).psnr;
+        const double toExact = compareImages(autoImage, exactImage).psnr;
+        std::printf("  %-48s auto vs table %7.2f dB, vs exact %7.2f dB\n", v.what, toTable, toExact);
+        if (v.exactIndex) {
+            EXPECT_GT(toExact, toTable + 20.0) << v.what;
+        } else {
+            EXPECT_TRUE(std::isinf(toTable)) << v.what << ": the table path, bit for bit";
+        }
+    }
 }
 
 // The point/splat switch does not show: moving the threshold τ from 0.7 to 1.4 px changes
