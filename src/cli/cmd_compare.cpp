@@ -5,16 +5,15 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <unistd.h>
 
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "image/image.h"
 #include "metrics/metrics.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace vdbsplat::cli {
@@ -76,26 +75,6 @@ nlohmann::ordered_json report(const ImageMetrics& m, const Image& image, const s
     return j;
 }
 
-void writeJsonAtomically(const std::string& path, const std::string& text) {
-    const std::string tmp = path + ".tmp" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        if (!out) throw Error(path + ": cannot open for writing");
-        out << text << "\n";
-        out.close();
-        if (!out) {
-            std::remove(tmp.c_str());
-            throw Error(path + ": write failed");
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::remove(tmp.c_str());
-        throw Error(path + ": cannot rename temporary file into place: " + ec.message());
-    }
-}
-
 }  // namespace
 
 int runCompare(const Argv& argv) {
@@ -113,7 +92,7 @@ int runCompare(const Argv& argv) {
         throw Error(pos[0] + " (" + sizeText(image) + ") and " + pos[1] + " (" + sizeText(reference) +
                     ") differ in size");
     const ImageMetrics m = compareImages(image, reference);
-    if (const auto json = args.get("--json")) writeJsonAtomically(*json, report(m, image, pos[0], pos[1]).dump());
+    if (const auto json = args.get("--json")) writeTextFileAtomic(*json, report(m, image, pos[0], pos[1]).dump() + "\n");
     std::cout << summaryLine(m, image) << "\n";
     return 0;
 }

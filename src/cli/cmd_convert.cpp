@@ -2,11 +2,11 @@
 // [--spacing SX,SY,SZ] [--threshold T]`.
 // Owns: the flags of the convert command; the reader itself is volume/raw.h.
 #include <chrono>
-#include <filesystem>
 #include <iostream>
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 #include "util/parse.h"
 #include "volume/grid.h"
@@ -40,13 +40,6 @@ RawSpec specFrom(const Args& args) {
     if (auto s = args.get("--spacing")) spec.spacing = parseUniformSpacing(*s, "--spacing");
     if (auto t = args.get("--threshold")) spec.threshold = parseDouble(*t, "--threshold");
     return spec;
-}
-
-void checkOutputDirectory(const std::string& out) {
-    const std::filesystem::path dir = std::filesystem::path(out).parent_path();
-    std::error_code ec;
-    if (!dir.empty() && !std::filesystem::is_directory(dir, ec))
-        throw Error(out + ": output directory '" + dir.string() + "' does not exist");
 }
 
 }  // namespace

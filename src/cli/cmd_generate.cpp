@@ -1,12 +1,12 @@
 // cli/cmd_generate.cpp — `vdbsplat generate KIND -o OUT.vdb [--res N] [--active N] [--seed S]`.
 // Owns: the flags of the generate command; the volumes themselves are in volume/generate.h.
 #include <chrono>
-#include <filesystem>
 #include <iostream>
 #include <limits>
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 #include "util/parse.h"
 #include "volume/generate.h"
@@ -46,13 +46,6 @@ GenerateOptions optionsFrom(const Args& args) {
         options.seed = uint64_t(parseInt(*seed, "--seed", 0, std::numeric_limits<long long>::max()));
     options.validate();
     return options;
-}
-
-void checkOutputDirectory(const std::string& out) {
-    const std::filesystem::path dir = std::filesystem::path(out).parent_path();
-    std::error_code ec;
-    if (!dir.empty() && !std::filesystem::is_directory(dir, ec))
-        throw Error(out + ": output directory '" + dir.string() + "' does not exist");
 }
 
 }  // namespace

@@ -10,6 +10,13 @@
 
 namespace vdbsplat {
 
+void checkOutputDirectory(const std::string& out) {
+    const std::filesystem::path dir = std::filesystem::path(out).parent_path();
+    std::error_code ec;
+    if (!dir.empty() && !std::filesystem::is_directory(dir, ec))
+        throw Error(out + ": output directory '" + dir.string() + "' does not exist");
+}
+
 void writeTextFileAtomic(const std::string& path, const std::string& text) {
     const std::string tmp = path + ".tmp" + std::to_string(::getpid());
     {

@@ -19,23 +19,14 @@
 #include "render/render.h"
 #include "util/error.h"
 #include "volume/grid.h"
+#include "support/error_of.h"
 
 namespace vdbsplat {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using test::errorOf;
 
-/// The message of the Error @p fn throws ("" and a failure when it throws none).
-template <typename Fn>
-std::string errorOf(Fn fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "no Error thrown";
-    return "";
-}
+constexpr double kPi = std::numbers::pi;
 
 bool has(const std::string& text, const std::string& needle) { return text.find(needle) != std::string::npos; }
 

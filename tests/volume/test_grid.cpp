@@ -15,9 +15,12 @@
 #include "util/error.h"
 #include "volume/generate.h"
 #include "volume/grid.h"
+#include "support/error_of.h"
 
 namespace vdbsplat {
 namespace {
+
+using test::errorOf;
 
 namespace fs = std::filesystem;
 using openvdb::Coord;
@@ -36,16 +39,6 @@ protected:
     std::string write(const std::string& name, openvdb::GridPtrVec grids) const {
         openvdb::io::File(path(name)).write(grids);
         return path(name);
-    }
-    template <typename Fn>
-    static std::string errorOf(Fn fn) {
-        try {
-            fn();
-        } catch (const Error& e) {
-            return e.what();
-        }
-        ADD_FAILURE() << "no Error thrown";
-        return "";
     }
     static bool has(const std::string& text, const std::string& needle) { return text.find(needle) != std::string::npos; }
 

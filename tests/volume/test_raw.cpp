@@ -14,9 +14,12 @@
 #include "util/error.h"
 #include "volume/grid.h"
 #include "volume/raw.h"
+#include "support/error_of.h"
 
 namespace vdbsplat {
 namespace {
+
+using test::errorOf;
 
 namespace fs = std::filesystem;
 using Bytes = std::vector<unsigned char>;
@@ -42,17 +45,6 @@ protected:
         EXPECT_EQ(gzwrite(f, data.data(), unsigned(data.size())), int(data.size()));
         gzclose(f);
         return path;
-    }
-    /// The message of the Error that @p fn throws ("" and a failure when it does not throw).
-    template <typename Fn>
-    static std::string errorOf(Fn fn) {
-        try {
-            fn();
-        } catch (const Error& e) {
-            return e.what();
-        }
-        ADD_FAILURE() << "no Error thrown";
-        return "";
     }
     std::string dir_;
 };

@@ -14,9 +14,12 @@
 #include "image/image.h"
 #include "util/error.h"
 #include "volume/transfer_function.h"
+#include "support/error_of.h"
 
 namespace vdbsplat {
 namespace {
+
+using test::errorOf;
 
 namespace fs = std::filesystem;
 
@@ -43,18 +46,6 @@ public:
 private:
     std::string path_;
 };
-
-/// The message of the Error that @p f throws ("" and a test failure if none).
-template <typename F>
-std::string errorOf(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "expected vdbsplat::Error";
-    return "";
-}
 
 void expectSame(const Classified& a, const Classified& b, float tol) {
     EXPECT_NEAR(a.sigma, b.sigma, tol);
