@@ -16,7 +16,7 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     const Tables& tables, const RenderSettings& settings, RenderStats& stats) {
-    VoxelStream stream(volume, camera, table);
+    VoxelStream stream(volume, camera, table, settings.stream);
     TileCompositor compositor(camera.width(), camera.height(), tables, ExactContext{&camera, volume.voxelSize});
     const ProjectionContext ctx{camera,          tables,           volume.voxelSize,  stream.slabLength(),
                                 settings.mode,   settings.threshold, settings.footprint, settings.showPrimitives};
@@ -43,6 +43,8 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     // Everything else drew nothing: outside the frustum, behind opaque tiles, off screen,
     // or transparent under the transfer function.
     stats.culled = volume.activeVoxels - stats.points - stats.splats;
+    stats.windows = stream.windows();
+    stats.largestWindow = stream.largestWindow();
     return compositor.image();
 }
 

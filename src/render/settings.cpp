@@ -95,6 +95,8 @@ nlohmann::json RenderStats::toJson() const {
     j["splats"] = splats;
     j["culled"] = culled;
     j["splats_exact_index"] = exactIndexSplats;
+    j["windows"] = windows;
+    j["largest_window_voxels"] = largestWindow;
     const uint64_t drawn = points + splats;
     j["splat_fraction"] = drawn ? double(splats) / double(drawn) : 0.0;
     if (rays) j["rays"] = rays;

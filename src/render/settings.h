@@ -7,6 +7,7 @@
 #include <string>
 
 #include "camera/camera.h"
+#include "volume/stream.h"
 
 namespace vdbsplat {
 
@@ -38,6 +39,7 @@ struct RenderSettings {
     FootprintPath footprint = FootprintPath::Auto;
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
     std::string tablesDir;                  ///< footprint/reindex tables; empty: defaultTablesDir()
+    StreamOptions stream;                   ///< how the grid is streamed: speed and memory, never the image
 
     /// @throw Error naming the flag of the first invalid value (--tables: DIR must be a directory).
     void validate() const;
@@ -50,6 +52,8 @@ struct RenderStats {
     uint64_t points = 0, splats = 0;  ///< primitives drawn (not hidden behind opaque tiles)
     uint64_t exactIndexSplats = 0;    ///< of the splats: drawn with the exact index (--footprint auto)
     uint64_t culled = 0;              ///< active voxels that drew nothing (frustum, occlusion, off screen, σ = 0)
+    uint64_t windows = 0;             ///< forward modes: depth windows streamed
+    uint64_t largestWindow = 0;       ///< forward modes: most voxels in one window
     uint64_t rays = 0;  ///< reference: rays traced
     int raysPerPixel = 0;  ///< reference: the --spp actually used (rounded up to a square)
     double streamSeconds = 0.0, projectSeconds = 0.0, rasterizeSeconds = 0.0, compositeSeconds = 0.0;

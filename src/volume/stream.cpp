@@ -32,7 +32,7 @@ void VoxelBatch::clear() {
 VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
                          const StreamOptions& options)
     : volume_(volume), camera_(camera), table_(table), options_(options),
-      slabLength_(options.slabThickness * volume.voxelSize) {
+      slabLength_(options.slabThickness * volume.voxelSize), slabsPerWindow_(std::max(1, options.slabsPerWindow)) {
     if (volume.activeVoxels > kMaxActiveVoxels)
         throw Error(volume.file + ": grid '" + volume.name + "' has " + std::to_string(volume.activeVoxels) +
                     " active voxels, more than the 2^32 vdbsplat streams");
@@ -155,6 +155,13 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out) const {
     }
 }
 
+void VoxelStream::adaptWindow(size_t released) {
+    const int widest = std::max(1, options_.slabsPerWindow);
+    if (released > options_.maxWindowVoxels && slabsPerWindow_ > 1) slabsPerWindow_ /= 2;
+    else if (released < options_.maxWindowVoxels / 4 && slabsPerWindow_ < widest)
+        slabsPerWindow_ = std::min(widest, 2 * slabsPerWindow_);
+}
+
 bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden) {
     batch.clear();
     while (true) {
@@ -164,7 +171,7 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
             nextSlab_ = std::max<int64_t>(nextSlab_, int64_t(std::floor(blocks_[nextBlock_].dMin / slabLength_)));
         }
         // The window: at least slabsPerWindow slabs, grown while it would hold too few voxels.
-        int64_t slabEnd = nextSlab_ + options_.slabsPerWindow;
+        int64_t slabEnd = nextSlab_ + slabsPerWindow_;
         size_t first = nextBlock_;
         size_t estimate = pending_.size();
         while (nextBlock_ < blocks_.size() && blocks_[nextBlock_].dMin < slabEnd * slabLength_) {
@@ -172,7 +179,7 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
             ++nextBlock_;
             if (nextBlock_ < blocks_.size() && estimate < options_.minWindowVoxels &&
                 blocks_[nextBlock_].dMin >= slabEnd * slabLength_)
-                slabEnd = int64_t(std::floor(blocks_[nextBlock_].dMin / slabLength_)) + options_.slabsPerWindow;
+                slabEnd = int64_t(std::floor(blocks_[nextBlock_].dMin / slabLength_)) + slabsPerWindow_;
         }
         // Activate the blocks whose front the window reached: extract them in parallel, in order.
         std::vector<VoxelBatch> extracted(nextBlock_ - first);
@@ -213,7 +220,12 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
         batch.slabBegin = nextSlab_;
         batch.slabEnd = slabEnd;
         nextSlab_ = slabEnd;
-        if (batch.size() > 0) return true;
+        adaptWindow(batch.size());
+        if (batch.size() > 0) {
+            ++windows_;
+            largest_ = std::max(largest_, batch.size());
+            return true;
+        }
     }
 }
 

@@ -35,6 +35,11 @@ struct StreamOptions {
     double slabThickness = 1.0;  ///< slab thickness in voxels (points are summed within one slab)
     int slabsPerWindow = 8;      ///< a window is this many slabs (more when they are nearly empty)
     size_t minWindowVoxels = 1 << 15;  ///< grow the window until it holds about this many voxels
+    /// Narrow the window (down to one slab) while windows hold more than this many voxels,
+    /// widen it again (up to slabsPerWindow) when they hold under a quarter: the projected
+    /// window is the renderer's largest buffer (two copies of ~150 B per voxel). Window
+    /// boundaries are slab boundaries, so the image does not depend on this.
+    size_t maxWindowVoxels = 1 << 20;
     double screenMargin = 4.0;   ///< pixels of margin around the image for frustum culling
 };
 
@@ -51,6 +56,8 @@ public:
     bool next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden = {});
 
     uint64_t culledVoxels() const { return culled_; }   ///< voxels in blocks culled so far
+    uint64_t windows() const { return windows_; }        ///< windows released so far
+    size_t largestWindow() const { return largest_; }    ///< most voxels in one window so far
     double slabLength() const { return slabLength_; }    ///< world length of one slab
 
 private:
@@ -66,6 +73,7 @@ private:
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
     void extract(const Block& b, VoxelBatch& out) const;
+    void adaptWindow(size_t released);  // the next window's slab count from this one's size
 
     const Volume& volume_;
     const Camera& camera_;
@@ -76,7 +84,10 @@ private:
     size_t nextBlock_ = 0;
     VoxelBatch pending_;          // voxels of activated blocks not yet released
     int64_t nextSlab_ = 0;
+    int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
     uint64_t culled_ = 0;
+    uint64_t windows_ = 0;
+    size_t largest_ = 0;
 };
 
 }  // namespace vdbsplat

@@ -329,6 +329,25 @@ TEST(Forward, ImagesDoNotDependOnThreadCount) {
     }
 }
 
+// The window size is a memory knob, never an image knob: narrowing the windows to a few
+// thousand voxels (a slab or two each) gives the same image, bit for bit, in every mode.
+TEST(Forward, ImagesDoNotDependOnTheWindowSize) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Point, RenderMode::Splat}) {
+        RenderSettings s = settingsFor(mode, 1.0);
+        RenderStats wide, narrow;
+        const Image a = renderWith(marschnerLobb(), tf, s, &wide);
+        s.stream.minWindowVoxels = 256;
+        s.stream.maxWindowVoxels = 2000;
+        const Image b = renderWith(marschnerLobb(), tf, s, &narrow);
+        EXPECT_GT(narrow.windows, 4 * wide.windows) << toString(mode);
+        EXPECT_LT(narrow.largestWindow, wide.largestWindow) << toString(mode);
+        ASSERT_EQ(a.pixels.size(), b.pixels.size());
+        for (size_t i = 0; i < a.pixels.size(); ++i)
+            ASSERT_EQ(a.pixels[i], b.pixels[i]) << toString(mode) << " pixel " << i;
+    }
+}
+
 TEST(Forward, ModesChooseTheirPrimitivesAndStatsAddUp) {
     const TransferFunction tf = TransferFunction::preset("grey");
     RenderStats hybrid, splat, point;

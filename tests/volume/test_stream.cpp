@@ -140,5 +140,68 @@ TEST(Stream, SameInputSameBatches) {
     }
 }
 
+// maxWindowVoxels bounds the windows: a window over the bound makes the next one half as
+// many slabs deep (down to one), so memory follows the densest slab rather than the densest
+// eight. The same voxels come out in the same slabs either way: windows split only at slab
+// boundaries.
+TEST(Stream, WindowsNarrowWhileOverTheVoxelBound) {
+    const Volume& v = cloud();
+    glm::dvec3 lo, hi;
+    v.worldBounds(lo, hi);
+    CameraSpec spec;
+    spec.width = spec.height = 96;
+    const Camera camera = makeCamera(spec, lo, hi);
+    const ClassificationTable table = constantTable(0.2f);
+    StreamOptions narrow;
+    narrow.minWindowVoxels = 1;
+    narrow.maxWindowVoxels = 3000;
+    StreamOptions wide = narrow;
+    wide.maxWindowVoxels = size_t(1) << 30;
+
+    struct Window { size_t voxels; int64_t slabs; };
+    // Every voxel tagged with its slab; and no slab may be split between two windows (the
+    // compositor flushes a slab's points when its window ends).
+    using Tagged = std::tuple<int64_t, float, float, float>;
+    const auto run = [&](const StreamOptions& o, std::vector<Window>& windows) {
+        VoxelStream stream(v, camera, table, o);
+        VoxelBatch batch;
+        std::vector<Tagged> voxels;
+        std::map<int64_t, size_t> windowOfSlab;
+        size_t largest = 0;
+        while (stream.next(batch)) {
+            windows.push_back({batch.size(), batch.slabEnd - batch.slabBegin});
+            largest = std::max(largest, batch.size());
+            for (size_t i = 0; i < batch.size(); ++i) {
+                const int64_t slab = int64_t(std::floor(batch.distance[i] / stream.slabLength()));
+                const auto [it, fresh] = windowOfSlab.try_emplace(slab, windows.size());
+                EXPECT_EQ(it->second, windows.size()) << "slab " << slab << " split between windows";
+                const glm::vec3 p = batch.viewPos[i];
+                voxels.emplace_back(slab, p.x, p.y, p.z);
+            }
+        }
+        EXPECT_EQ(stream.largestWindow(), largest);
+        EXPECT_EQ(stream.windows(), windows.size());
+        std::sort(voxels.begin(), voxels.end());
+        return voxels;
+    };
+    std::vector<Window> n, w;
+    EXPECT_EQ(run(narrow, n), run(wide, w));  // the same voxels in the same slabs
+    const auto largest = [](const std::vector<Window>& ws) {
+        size_t m = 0;
+        for (const Window& x : ws) m = std::max(m, x.voxels);
+        return m;
+    };
+    EXPECT_GT(n.size(), 2 * w.size());
+    EXPECT_LT(largest(n), largest(w) / 2);
+    int narrowed = 0;
+    for (size_t k = 0; k + 1 < n.size(); ++k)
+        if (n[k].voxels > narrow.maxWindowVoxels && n[k].slabs > 1) {
+            EXPECT_EQ(n[k + 1].slabs, n[k].slabs / 2) << "window " << k;
+            ++narrowed;
+        }
+    EXPECT_GT(narrowed, 0);
+    for (const Window& x : w) EXPECT_EQ(x.slabs, wide.slabsPerWindow);  // never narrowed
+}
+
 }  // namespace
 }  // namespace vdbsplat
