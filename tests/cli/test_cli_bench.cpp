@@ -5,73 +5,39 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
-#include <sys/wait.h>
+
+#include "support/cli.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using vdbsplat::test::CliResult;
+using vdbsplat::test::slurp;
 
-struct BenchResult {
-    int rc = -1;
-    std::string out, err;
-};
-
-std::string slurpFile(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-/// A scratch folder under /tmp holding a 24³ generated sphere, removed afterwards.
+/// A scratch folder holding a 24³ generated sphere, removed afterwards.
 class BenchCli : public ::testing::Test {
 protected:
     void SetUp() override {
-        std::string pattern = "/tmp/vdbsplat-bench-XXXXXX";
-        ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-        dir_ = pattern;
-        const BenchResult g = run("generate sphere -o '" + path("s.vdb") + "' --res 24");
+        const CliResult g = run("generate sphere -o '" + path("s.vdb") + "' --res 24");
         ASSERT_EQ(g.rc, 0) << g.err;
         ASSERT_TRUE(fs::exists(path("s.vdb")));
     }
-    void TearDown() override {
-        std::error_code ec;
-        fs::remove_all(dir_, ec);
-    }
-    std::string path(const std::string& name) const { return dir_ + "/" + name; }
+    std::string path(const std::string& name) const { return scratch_.path(name); }
 
     /// Runs `vdbsplat <args>` and captures its exit code, stdout and stderr.
-    BenchResult run(const std::string& args) const {
-        const std::string out = path("stdout.txt"), err = path("stderr.txt");
-        const std::string cmd = std::string("'") + VDBSPLAT_BINARY + "' " + args + " >'" + out + "' 2>'" + err + "'";
-        const int status = std::system(cmd.c_str());
-        BenchResult r;
-        r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        r.out = slurpFile(out);
-        r.err = slurpFile(err);
-        return r;
-    }
-    BenchResult bench(const std::string& args) const { return run("bench '" + path("s.vdb") + "' " + args); }
+    CliResult run(const std::string& args) const { return vdbsplat::test::runVdbsplat(args, scratch_.dir()); }
+    CliResult bench(const std::string& args) const { return run("bench '" + path("s.vdb") + "' " + args); }
 
     /// Expects a failure with exactly one line "vdbsplat: error: …" containing @p what, and no JSON.
-    void expectError(const BenchResult& r, const std::string& what, const std::string& json) const {
-        EXPECT_NE(r.rc, 0);
-        EXPECT_EQ(r.err.rfind("vdbsplat: error: ", 0), 0u) << r.err;
-        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-        EXPECT_NE(r.err.find(what), std::string::npos) << "missing '" << what << "' in: " << r.err;
-        EXPECT_TRUE(r.out.empty()) << r.out;
+    void expectError(const CliResult& r, const std::string& what, const std::string& json) const {
+        vdbsplat::test::expectOneLineError(r, what);
         EXPECT_FALSE(fs::exists(json)) << json;
-        for (const auto& e : fs::directory_iterator(dir_))  // no temporary left behind either
-            EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
+        vdbsplat::test::expectNoTemporaries(scratch_.dir());
     }
 
-    std::string dir_;
+    vdbsplat::test::ScratchDir scratch_{"bench"};
 };
 
 const nlohmann::json& resultFor(const nlohmann::json& j, double distance, const std::string& mode) {
@@ -81,7 +47,7 @@ const nlohmann::json& resultFor(const nlohmann::json& j, double distance, const 
 }
 
 TEST_F(BenchCli, HelpExitsZero) {
-    const BenchResult r = run("bench --help");
+    const CliResult r = run("bench --help");
     EXPECT_EQ(r.rc, 0);
     EXPECT_NE(r.out.find("usage: vdbsplat bench FILE.vdb"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("--distances"), std::string::npos) << r.out;
@@ -90,13 +56,13 @@ TEST_F(BenchCli, HelpExitsZero) {
 
 TEST_F(BenchCli, ThreeViewsThreeModesJson) {
     const std::string json = path("out.json");
-    const BenchResult r = bench("--size 48x48 --runs 2 --warmup 0 --json '" + json + "'");
+    const CliResult r = bench("--size 48x48 --runs 2 --warmup 0 --json '" + json + "'");
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_TRUE(r.err.empty()) << r.err;
     EXPECT_NE(r.out.find("ratio_to_hybrid"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("median over distances"), std::string::npos) << r.out;
 
-    const auto j = nlohmann::json::parse(slurpFile(json));
+    const auto j = nlohmann::json::parse(slurp(json));
     EXPECT_EQ(j.at("volume"), path("s.vdb"));
     EXPECT_EQ(j.at("grid"), "density");
     EXPECT_EQ(j.at("active_voxels").get<uint64_t>(), 6272u);  // `generate sphere --res 24`
@@ -167,10 +133,10 @@ TEST_F(BenchCli, ThreeViewsThreeModesJson) {
 
 TEST_F(BenchCli, ModeAndDistanceSubsets) {
     const std::string json = path("sub.json");
-    const BenchResult r =
+    const CliResult r =
         bench("--size 24x16 --runs 1 --warmup 1 --modes point,hybrid --distances 2,0.5 --json=" + json);
     ASSERT_EQ(r.rc, 0) << r.err;
-    const auto j = nlohmann::json::parse(slurpFile(json));
+    const auto j = nlohmann::json::parse(slurp(json));
     EXPECT_EQ(j.at("width"), 24);
     EXPECT_EQ(j.at("height"), 16);
     ASSERT_EQ(j.at("results").size(), 4u);
@@ -186,9 +152,9 @@ TEST_F(BenchCli, ModeAndDistanceSubsets) {
 
 TEST_F(BenchCli, WithoutHybridThereAreNoRatios) {
     const std::string json = path("nohybrid.json");
-    const BenchResult r = bench("--size 16x16 --runs 1 --warmup 0 --modes splat --distances 1 --json " + json);
+    const CliResult r = bench("--size 16x16 --runs 1 --warmup 0 --modes splat --distances 1 --json " + json);
     ASSERT_EQ(r.rc, 0) << r.err;
-    const auto j = nlohmann::json::parse(slurpFile(json));
+    const auto j = nlohmann::json::parse(slurp(json));
     ASSERT_EQ(j.at("results").size(), 1u);
     EXPECT_TRUE(j["results"][0].at("ratio_to_hybrid").is_null());
     EXPECT_TRUE(j.at("ratios").at("splat").is_null());
@@ -196,11 +162,11 @@ TEST_F(BenchCli, WithoutHybridThereAreNoRatios) {
 
 TEST_F(BenchCli, ReferenceIsAllowedWithAWarning) {
     const std::string json = path("ref.json");
-    const BenchResult r =
+    const CliResult r =
         bench("--size 8x8 --runs 1 --warmup 0 --modes hybrid,reference --distances 1 --json " + json);
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_EQ(r.err.rfind("vdbsplat: warning: reference mode", 0), 0u) << r.err;
-    const auto j = nlohmann::json::parse(slurpFile(json));
+    const auto j = nlohmann::json::parse(slurp(json));
     ASSERT_EQ(j.at("results").size(), 2u);
     EXPECT_TRUE(j["results"][1].at("splat_fraction").is_null());  // no points or splats drawn
     EXPECT_TRUE(j["results"][1].at("ratio_to_hybrid").is_number());

@@ -3,70 +3,34 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 #include "image/image.h"
 #include "metrics/metrics.h"
+#include "support/cli.h"
 
 namespace vdbsplat {
 namespace {
 
 namespace fs = std::filesystem;
+using test::CliResult;
+using test::slurp;
 
-struct RunResult {
-    int rc = -1;
-    std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-/// A scratch folder under /tmp for one test, removed afterwards.
+/// A scratch folder for one test, removed afterwards.
 class CompareCli : public ::testing::Test {
 protected:
-    void SetUp() override {
-        std::string pattern = "/tmp/vdbsplat-compare-XXXXXX";
-        ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-        dir_ = pattern;
-    }
-    void TearDown() override {
-        std::error_code ec;
-        fs::remove_all(dir_, ec);
-    }
-    std::string path(const std::string& name) const { return dir_ + "/" + name; }
+    std::string path(const std::string& name) const { return scratch_.path(name); }
 
     /// Runs `vdbsplat compare <args>` and captures its exit code, stdout and stderr.
-    RunResult compare(const std::string& args) const {
-        const std::string out = path("stdout.txt"), err = path("stderr.txt");
-        const std::string cmd = std::string("'") + VDBSPLAT_BINARY + "' compare " + args + " >'" + out + "' 2>'" + err + "'";
-        const int status = std::system(cmd.c_str());
-        RunResult r;
-        r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        r.out = slurp(out);
-        r.err = slurp(err);
-        return r;
-    }
+    CliResult compare(const std::string& args) const { return test::runVdbsplat("compare " + args, scratch_.dir()); }
 
     /// Expects a failure with exactly one line "vdbsplat: error: …" containing @p what.
-    void expectError(const RunResult& r, const std::string& what) const {
-        EXPECT_NE(r.rc, 0);
-        EXPECT_EQ(r.err.rfind("vdbsplat: error: ", 0), 0u) << r.err;
-        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-        EXPECT_NE(r.err.find(what), std::string::npos) << "missing '" << what << "' in: " << r.err;
-        EXPECT_TRUE(r.out.empty()) << r.out;
-    }
+    void expectError(const CliResult& r, const std::string& what) const { test::expectOneLineError(r, what); }
 
-    std::string dir_;
+    test::ScratchDir scratch_{"compare"};
 };
 
 Image gradient(int w, int h, float offset) {
@@ -89,7 +53,7 @@ std::string field(const std::string& line, const std::string& key) {
 
 TEST_F(CompareCli, IdenticalImagesPrintInfinitePsnr) {
     writeImage(path("a.exr"), gradient(32, 16, 0.f));
-    const RunResult r = compare("'" + path("a.exr") + "' '" + path("a.exr") + "'");
+    const CliResult r = compare("'" + path("a.exr") + "' '" + path("a.exr") + "'");
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
     EXPECT_EQ(field(r.out, "psnr"), "inf");
@@ -102,7 +66,7 @@ TEST_F(CompareCli, PrintsAndWritesTheLibraryMetrics) {
     writeImage(path("a.exr"), a);
     writeImage(path("b.exr"), b);
     const ImageMetrics expected = compareImages(readImage(path("a.exr")), readImage(path("b.exr")));
-    const RunResult r = compare("'" + path("a.exr") + "' '" + path("b.exr") + "' --json '" + path("m.json") + "'");
+    const CliResult r = compare("'" + path("a.exr") + "' '" + path("b.exr") + "' --json '" + path("m.json") + "'");
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_NEAR(std::stod(field(r.out, "psnr")), expected.psnr, 1e-3);
     const auto j = nlohmann::json::parse(slurp(path("m.json")));
@@ -119,7 +83,7 @@ TEST_F(CompareCli, PrintsAndWritesTheLibraryMetrics) {
 
 TEST_F(CompareCli, PngAgainstItsEightBitSelfAndIdenticalJson) {
     writeImage(path("a.png"), gradient(20, 20, 0.1f));
-    const RunResult r = compare("'" + path("a.png") + "' '" + path("a.png") + "' --json=" + path("m.json"));
+    const CliResult r = compare("'" + path("a.png") + "' '" + path("a.png") + "' --json=" + path("m.json"));
     ASSERT_EQ(r.rc, 0) << r.err;
     const auto j = nlohmann::json::parse(slurp(path("m.json")));
     EXPECT_TRUE(j.at("psnr_db").is_null());
@@ -128,7 +92,7 @@ TEST_F(CompareCli, PngAgainstItsEightBitSelfAndIdenticalJson) {
 }
 
 TEST_F(CompareCli, HelpExitsZero) {
-    const RunResult r = compare("--help");
+    const CliResult r = compare("--help");
     EXPECT_EQ(r.rc, 0);
     EXPECT_NE(r.out.find("usage: vdbsplat compare IMAGE REFERENCE [--json FILE]"), std::string::npos);
 }
@@ -147,7 +111,7 @@ TEST_F(CompareCli, UnreadableImage) {
 TEST_F(CompareCli, SizeMismatch) {
     writeImage(path("a.exr"), gradient(8, 8, 0.f));
     writeImage(path("b.exr"), gradient(9, 8, 0.f));
-    const RunResult r = compare("'" + path("a.exr") + "' '" + path("b.exr") + "' --json '" + path("m.json") + "'");
+    const CliResult r = compare("'" + path("a.exr") + "' '" + path("b.exr") + "' --json '" + path("m.json") + "'");
     expectError(r, "(8x8) and " + path("b.exr") + " (9x8) differ in size");
     EXPECT_FALSE(fs::exists(path("m.json")));
 }

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "support/cli.h"
 #include "volume/generate.h"
 #include "volume/grid.h"
 
@@ -39,27 +40,13 @@ namespace vdbsplat {
 namespace {
 
 namespace fs = std::filesystem;
+using test::slurp;
+using test::spit;
 
 const std::vector<std::string> kAllModes = {"hybrid", "splat", "point", "reference"};
 const std::vector<std::string> kForwardModes = {"hybrid", "splat", "point"};
 
-struct Result {
-    int rc = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-void spit(const fs::path& p, const std::string& bytes) {
-    std::ofstream out(p, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    ASSERT_TRUE(out.good()) << p;
-}
+using Result = test::CliResult;
 
 /// Runs `vdbsplat ARGS…` (no shell), stdout and stderr captured through files in @p logDir.
 Result runBinary(const std::vector<std::string>& args, const fs::path& logDir) {

@@ -5,58 +5,32 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <string>
+
+#include "support/cli.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Result {
-    int rc = -1;
-    std::string out, err;
-};
+using Result = vdbsplat::test::CliResult;
+using vdbsplat::test::slurp;
 
 class CliVolume : public ::testing::Test {
 protected:
-    void SetUp() override {
-        char tmpl[] = "/tmp/vdbsplat_cli_vol_XXXXXX";
-        ASSERT_NE(mkdtemp(tmpl), nullptr);
-        dir_ = tmpl;
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    std::string path(const std::string& name) const { return dir_ + "/" + name; }
-
-    static std::string slurp(const std::string& p) {
-        std::ifstream in(p);
-        std::stringstream s;
-        s << in.rdbuf();
-        return s.str();
-    }
+    std::string path(const std::string& name) const { return scratch_.path(name); }
 
     /// Runs `vdbsplat <args>` and captures its exit code, stdout and stderr.
-    Result run(const std::string& args) const {
-        const std::string cmd = std::string(VDBSPLAT_BINARY) + " " + args + " >" + path("stdout") + " 2>" + path("stderr");
-        const int status = std::system(cmd.c_str());
-        Result r;
-        r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        r.out = slurp(path("stdout"));
-        r.err = slurp(path("stderr"));
-        return r;
-    }
+    Result run(const std::string& args) const { return vdbsplat::test::runVdbsplat(args, scratch_.dir()); }
 
-    /// Expects failure with a single "vdbsplat: error:" line that contains @p needle, and no @p output.
+    /// Expects exit code 1 with a single "vdbsplat: error:" line that contains @p needle, and no @p output.
     void expectError(const std::string& args, const std::string& needle, const std::string& output = "") const {
         const Result r = run(args);
         EXPECT_EQ(r.rc, 1) << args;
-        EXPECT_EQ(r.err.rfind("vdbsplat: error: ", 0), 0u) << args << "\n" << r.err;
-        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
-        EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\nexpected '" << needle << "' in: " << r.err;
+        vdbsplat::test::expectOneLineError(r, needle, args);
         if (!output.empty()) {
             EXPECT_FALSE(fs::exists(output)) << args;
         }
-        for (const auto& e : fs::directory_iterator(dir_))  // no temporary left behind either
-            EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
+        vdbsplat::test::expectNoTemporaries(scratch_.dir());
     }
 
     std::string writeBytes(const std::string& name, size_t n) const {
@@ -66,7 +40,7 @@ protected:
         return path(name);
     }
 
-    std::string dir_;
+    vdbsplat::test::ScratchDir scratch_{"cli-volume"};
 };
 
 TEST_F(CliVolume, HelpExitsZero) {

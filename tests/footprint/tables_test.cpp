@@ -14,25 +14,16 @@
 #include "footprint/kernel.h"
 #include "footprint/reindex.h"
 #include "footprint/tables.h"
+#include "support/cli.h"
 #include "util/error.h"
 
 namespace vdbsplat {
 namespace {
 
 namespace fs = std::filesystem;
+using test::slurp;
+using test::spit;
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-void spit(const fs::path& p, const std::string& bytes) {
-    std::ofstream out(p, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
 
 /// A fresh temporary copy of the shipped tables.
 fs::path copyShipped(const std::string& tag) {

@@ -31,6 +31,16 @@ struct Streamed {
     size_t largestBatch = 0;
 };
 
+/// The default framing of @p v at @p size² pixels and @p distance times the framing distance.
+Camera framedCamera(const Volume& v, int size, double distance = 1.0) {
+    glm::dvec3 lo, hi;
+    v.worldBounds(lo, hi);
+    CameraSpec spec;
+    spec.width = spec.height = size;
+    spec.distance = distance;
+    return makeCamera(spec, lo, hi);
+}
+
 Streamed streamAll(const Volume& v, const Camera& camera, const ClassificationTable& table) {
     VoxelStream stream(v, camera, table);
     Streamed s;
@@ -48,11 +58,7 @@ Streamed streamAll(const Volume& v, const Camera& camera, const ClassificationTa
 // window's slabs, and the view positions are the camera's transform of the voxel centres.
 TEST(Stream, WindowsAreFrontToBackAndVoxelsInTheirSlabs) {
     const Volume& v = cloud();
-    glm::dvec3 lo, hi;
-    v.worldBounds(lo, hi);
-    CameraSpec spec;
-    spec.width = spec.height = 128;
-    const Camera camera = makeCamera(spec, lo, hi);
+    const Camera camera = framedCamera(v, 128);
     const ClassificationTable table = constantTable(0.2f);
     VoxelStream stream(v, camera, table);
     VoxelBatch batch;
@@ -77,11 +83,7 @@ TEST(Stream, WindowsAreFrontToBackAndVoxelsInTheirSlabs) {
 // classification; σ = 0 voxels never do.
 TEST(Stream, EveryVisibleVoxelExactlyOnce) {
     const Volume& v = cloud();
-    glm::dvec3 lo, hi;
-    v.worldBounds(lo, hi);
-    CameraSpec spec;
-    spec.width = spec.height = 96;
-    const Camera camera = makeCamera(spec, lo, hi);  // framed: everything visible
+    const Camera camera = framedCamera(v, 96);  // framed: everything visible
     const ClassificationTable table = constantTable(0.2f);
     const Streamed s = streamAll(v, camera, table);
     EXPECT_EQ(s.voxels + s.culled, v.activeVoxels);
@@ -125,12 +127,7 @@ TEST(Stream, CullsBehindTheEyeAndOutsideTheFrustum) {
 // everything downstream is deterministic.
 TEST(Stream, SameInputSameBatches) {
     const Volume& v = cloud();
-    glm::dvec3 lo, hi;
-    v.worldBounds(lo, hi);
-    CameraSpec spec;
-    spec.width = spec.height = 64;
-    spec.distance = 0.6;
-    const Camera camera = makeCamera(spec, lo, hi);
+    const Camera camera = framedCamera(v, 64, 0.6);
     const ClassificationTable table = constantTable(0.3f);
     const Streamed a = streamAll(v, camera, table), b = streamAll(v, camera, table);
     ASSERT_EQ(a.batches.size(), b.batches.size());
@@ -146,11 +143,7 @@ TEST(Stream, SameInputSameBatches) {
 // boundaries.
 TEST(Stream, WindowsNarrowWhileOverTheVoxelBound) {
     const Volume& v = cloud();
-    glm::dvec3 lo, hi;
-    v.worldBounds(lo, hi);
-    CameraSpec spec;
-    spec.width = spec.height = 96;
-    const Camera camera = makeCamera(spec, lo, hi);
+    const Camera camera = framedCamera(v, 96);
     const ClassificationTable table = constantTable(0.2f);
     StreamOptions narrow;
     narrow.minWindowVoxels = 1;
