@@ -37,6 +37,27 @@ int dispatch(const std::string& command, const vdbsplat::cli::Argv& args) {
 
 }  // namespace
 
+namespace {
+
+/// The message on one line: control characters (a newline in a corrupt file's grid name,
+/// say) are written as \n, \t or \xHH, and past 1000 characters it is cut with "…".
+std::string oneLine(const std::string& message) {
+    static const char* hex = "0123456789abcdef";
+    constexpr size_t kMaxChars = 1000;
+    std::string out;
+    for (const char c : message) {
+        if (out.size() >= kMaxChars) return out + "…";
+        const auto u = static_cast<unsigned char>(c);
+        if (c == '\n') out += "\\n";
+        else if (c == '\t') out += "\\t";
+        else if (u < 0x20 || u == 0x7f) out += std::string("\\x") + hex[u >> 4] + hex[u & 15];
+        else out += c;
+    }
+    return out;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
     if (argc < 2) {
         std::cerr << kUsage;
@@ -54,11 +75,11 @@ int main(int argc, char** argv) {
     try {
         return dispatch(command, vdbsplat::cli::Argv(argv + 2, argv + argc));
     } catch (const vdbsplat::Error& e) {
-        std::cerr << "vdbsplat: error: " << e.what() << "\n";
+        std::cerr << "vdbsplat: error: " << oneLine(e.what()) << "\n";
     } catch (const std::bad_alloc&) {
         std::cerr << "vdbsplat: error: out of memory\n";
     } catch (const std::exception& e) {
-        std::cerr << "vdbsplat: error: " << e.what() << "\n";
+        std::cerr << "vdbsplat: error: " << oneLine(e.what()) << "\n";
     }
     return 1;
 }

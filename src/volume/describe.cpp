@@ -95,22 +95,11 @@ std::string describeGrid(const openvdb::GridBase& grid, size_t index) {
     return s.str();
 }
 
-}  // namespace
-
-std::string describeFile(const std::string& path) {
-    initOpenVdb();
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
-    if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a regular file");
-    checkVdbStructure(path);  // OpenVDB does not bound its reads on truncated files
+/// Every grid of @p path, and the file's version.
+openvdb::GridPtrVecPtr readAllGrids(const std::string& path, std::string& version) {
     openvdb::io::File file(path);
-    try {
-        file.open(/*delayLoad=*/false);
-    } catch (const std::exception& e) {
-        throw Error(path + ": not a readable VDB file (" + std::string(e.what()) + ")");
-    }
+    openVdbFile(file, path);
     openvdb::GridPtrVecPtr grids;
-    std::string version;
     try {
         version = file.version();
         grids = file.getGrids();
@@ -118,6 +107,18 @@ std::string describeFile(const std::string& path) {
         throw Error(path + ": corrupt or truncated VDB file (" + std::string(e.what()) + ")");
     }
     file.close();
+    return grids;
+}
+
+}  // namespace
+
+std::string describeFile(const std::string& path) {
+    initOpenVdb();
+    OpenVdbLogCapture log;  // OpenVDB's warnings about a bad file stay out of its one-line error
+    std::string version;
+    readInChildProcess(path, [&] { readAllGrids(path, version); });  // a crash there is an Error here
+    const openvdb::GridPtrVecPtr grids = readAllGrids(path, version);
+    log.keep();
     std::ostringstream s;
     s << path << ": VDB file version " << version << ", " << grids->size() << " grid" << (grids->size() == 1 ? "" : "s")
       << "\n";

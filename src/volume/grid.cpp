@@ -17,19 +17,6 @@ namespace {
 
 bool isScalarType(const std::string& type) { return type == "float" || type == "double"; }
 
-/// Opens @p path as a VDB (no delayed loading, so a truncated file fails here, not mid-render).
-void openFile(openvdb::io::File& file, const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
-    if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a regular file");
-    checkVdbStructure(path);  // OpenVDB does not bound its reads on truncated files
-    try {
-        file.open(/*delayLoad=*/false);
-    } catch (const std::exception& e) {
-        throw Error(path + ": not a readable VDB file (" + std::string(e.what()) + ")");
-    }
-}
-
 /// Converts a double grid to a float grid of the same topology, transform and metadata.
 openvdb::FloatGrid::Ptr toFloatGrid(const openvdb::GridBase::Ptr& base) {
     if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) return f;
@@ -117,10 +104,12 @@ Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label) {
     return v;
 }
 
-Volume loadVolume(const std::string& path, const std::string& gridName) {
-    initOpenVdb();
+namespace {
+
+/// Opens @p path and reads the grid to render: @p gridName, or the first float or double grid.
+openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::string& gridName) {
     openvdb::io::File file(path);
-    openFile(file, path);
+    openVdbFile(file, path);
     openvdb::GridBase::Ptr base;
     try {
         const auto metas = file.readAllGridMetadata();
@@ -144,6 +133,17 @@ Volume loadVolume(const std::string& path, const std::string& gridName) {
         throw Error(path + ": corrupt or truncated VDB file (" + std::string(e.what()) + ")");
     }
     file.close();
+    return base;
+}
+
+}  // namespace
+
+Volume loadVolume(const std::string& path, const std::string& gridName) {
+    initOpenVdb();
+    OpenVdbLogCapture log;  // OpenVDB's warnings about a bad file stay out of its one-line error
+    readInChildProcess(path, [&] { readGridToRender(path, gridName); });  // a crash there is an Error here
+    const openvdb::GridBase::Ptr base = readGridToRender(path, gridName);
+    log.keep();
     Volume v = makeVolume(toFloatGrid(base), path);
     v.file = path;
     return v;

@@ -4,11 +4,23 @@
 // (int32 count; per item: name string, type string, uint32 size, bytes), int32 grid
 // count, then per grid: name, type, instance-parent strings, int64 gridPos, blockPos,
 // endPos, and the grid's bytes up to endPos. Strings are uint32 length + bytes.
+// A grid's own header, at gridPos: uint32 compression flags (versions 222+), its metadata
+// (the same layout as the file's), the transform's map type name, ... topology, and its
+// leaf buffers from blockPos. Its metadata and map name must end before blockPos: OpenVDB
+// allocates whatever lengths it finds there (gigabytes from a flipped byte) and loops over
+// whatever count (minutes).
 #include "volume/vdb_check.h"
 
+#include <algorithm>
+#include <cerrno>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <utility>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "util/error.h"
 
@@ -19,6 +31,7 @@ namespace {
 constexpr int64_t kVdbMagic = 0x56444220;
 constexpr uint32_t kFirstCheckedVersion = 213;  ///< UUID as 36 characters; older files are left to OpenVDB
 constexpr uint32_t kInstancingVersion = 216;     ///< grid descriptors carry an instance-parent name
+constexpr uint32_t kGridCompressionVersion = 222;  ///< each grid starts with its compression flags
 
 /// Bounds-checked little-endian reads from an ifstream of known size.
 class Reader {
@@ -40,6 +53,25 @@ public:
         in_.seekg(std::streamoff(pos_));
     }
     void skipString(const char* what) { skip(value<uint32_t>(what), what); }
+    /// A string of at most @p maxLength bytes; longer ones are skipped and read as "".
+    std::string string(const char* what, uint32_t maxLength = 64) {
+        const uint32_t n = value<uint32_t>(what);
+        need(n, what);
+        if (n > maxLength) {
+            skip(n, what);
+            return "";
+        }
+        std::string text(n, '\0');
+        in_.read(text.data(), n);
+        pos_ += n;
+        return text;
+    }
+    /// Back to @p to, a position already passed (seek only goes forward).
+    void rewind(uint64_t to) {
+        pos_ = std::min(to, size_);
+        in_.clear();
+        in_.seekg(std::streamoff(pos_));
+    }
     void seek(uint64_t to, const char* what) {
         if (to < pos_ || to > size_) corrupt(what);
         pos_ = to;
@@ -47,6 +79,8 @@ public:
     }
     uint64_t pos() const { return pos_; }
     uint64_t size() const { return size_; }
+    /// Reads past @p end (≤ size) are corrupt until the limit is lifted with limit(size()).
+    void limit(uint64_t end) { end_ = std::min(end, size_); }
     [[noreturn]] void corrupt(const char* what) const {
         throw Error(path_ + ": truncated or corrupt VDB file (" + what + " at byte " + std::to_string(pos_) + " of " +
                     std::to_string(size_) + ")");
@@ -54,16 +88,17 @@ public:
 
 private:
     void need(uint64_t n, const char* what) {
-        if (n > size_ - pos_ || !in_) corrupt(what);
+        if (pos_ > end_ || n > end_ - pos_ || !in_) corrupt(what);
     }
     std::ifstream in_;
-    uint64_t size_, pos_ = 0;
+    uint64_t size_, pos_ = 0, end_ = size_;
     std::string path_;
 };
 
-void skipFileMetadata(Reader& r) {
-    const int32_t count = r.value<int32_t>("file metadata count");
-    if (count < 0 || uint64_t(count) > (r.size() - r.pos()) / 12) r.corrupt("file metadata count");
+/// A metadata block (the file's or a grid's): every item within the reader's limit.
+void skipMetadata(Reader& r, uint64_t end) {
+    const int32_t count = r.value<int32_t>("metadata count");
+    if (count < 0 || uint64_t(count) > (end - std::min(end, r.pos())) / 12) r.corrupt("metadata count");
     for (int32_t i = 0; i < count; ++i) {
         r.skipString("metadata name");
         r.skipString("metadata type");
@@ -71,18 +106,66 @@ void skipFileMetadata(Reader& r) {
     }
 }
 
+/// Bytes of a map's data after its type name (math/Maps.cc: ScaleMap reads five Vec3d,
+/// ScaleTranslateMap six, TranslationMap one, AffineMap and UnitaryMap a Mat4d); 0 for
+/// others (a frustum map: variable), which end the check there.
+uint64_t mapBytes(const std::string& type) {
+    if (type == "UniformScaleMap" || type == "ScaleMap") return 5 * 24;
+    if (type == "UniformScaleTranslateMap" || type == "ScaleTranslateMap") return 6 * 24;
+    if (type == "TranslationMap") return 24;
+    if (type == "AffineMap" || type == "UnitaryMap") return 128;
+    return 0;
+}
+
+/// Bytes of a tree's value type from the grid type ("Tree_float_5_4_3"); 0 when unknown.
+uint64_t valueBytes(const std::string& gridType) {
+    static const std::pair<const char*, uint64_t> kTypes[] = {
+        {"Tree_float_", 4}, {"Tree_double_", 8}, {"Tree_int32_", 4}, {"Tree_int64_", 8}, {"Tree_bool_", 1},
+        {"Tree_vec3s_", 12}, {"Tree_vec3d_", 24}, {"Tree_vec3i_", 12}};
+    for (const auto& [prefix, bytes] : kTypes)
+        if (gridType.rfind(prefix, 0) == 0) return bytes;
+    return 0;
+}
+
+/// The grid's header in [gridPos, blockPos): compression flags, metadata, transform, and the
+/// root node's tile and child counts, each tile or child taking at least 13 bytes there
+/// (a flipped high byte of a count made OpenVDB loop 3.5 billion times: a minute).
+void checkGridHeader(Reader& r, uint32_t version, const std::string& gridType, uint64_t gridPos,
+                     uint64_t blockPos) {
+    const uint64_t resume = r.pos();
+    r.seek(gridPos, "grid offset");
+    r.limit(blockPos);
+    if (version >= kGridCompressionVersion) r.value<uint32_t>("grid compression flags");
+    skipMetadata(r, blockPos);
+    if (version >= kInstancingVersion) {  // older files put the topology first
+        const uint64_t map = mapBytes(r.string("grid transform type"));
+        const uint64_t value = valueBytes(gridType);
+        if (map > 0 && value > 0) {
+            r.skip(map, "grid transform");
+            r.value<int32_t>("tree buffer count");
+            r.skip(value, "root background value");
+            const uint64_t tiles = r.value<uint32_t>("root tile count");
+            const uint64_t children = r.value<uint32_t>("root child count");
+            if ((tiles + children) * 13 > blockPos - r.pos()) r.corrupt("root node tile or child count");
+        }
+    }
+    r.limit(r.size());
+    r.rewind(resume);
+}
+
 void checkGridDescriptors(Reader& r, uint32_t version) {
     const int32_t grids = r.value<int32_t>("grid count");
     if (grids < 0 || uint64_t(grids) > (r.size() - r.pos()) / 32) r.corrupt("grid count");
     for (int32_t i = 0; i < grids; ++i) {
         r.skipString("grid name");
-        r.skipString("grid type");
+        const std::string type = r.string("grid type");
         if (version >= kInstancingVersion) r.skipString("grid instance parent");
         const int64_t gridPos = r.value<int64_t>("grid offset");
         const int64_t blockPos = r.value<int64_t>("grid data offset");
         const int64_t endPos = r.value<int64_t>("grid end offset");
         if (gridPos < int64_t(r.pos()) || blockPos < gridPos || endPos < blockPos || uint64_t(endPos) > r.size())
             r.corrupt("grid extends past the end of the file");
+        checkGridHeader(r, version, type, uint64_t(gridPos), uint64_t(blockPos));
         r.seek(uint64_t(endPos), "grid end offset");
     }
 }
@@ -102,8 +185,82 @@ void checkVdbStructure(const std::string& path) {
     r.value<uint32_t>("library minor version");
     const char hasOffsets = r.value<char>("grid offsets flag");
     r.skip(36, "file UUID");
-    skipFileMetadata(r);
+    skipMetadata(r, size);
     if (hasOffsets) checkGridDescriptors(r, version);
+}
+
+void openVdbFile(openvdb::io::File& file, const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
+    if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a regular file");
+    checkVdbStructure(path);  // OpenVDB does not bound its reads on truncated files
+    try {
+        file.open(/*delayLoad=*/false);
+    } catch (const std::exception& e) {
+        throw Error(path + ": not a readable VDB file (" + std::string(e.what()) + ")");
+    }
+}
+
+OpenVdbLogCapture::OpenVdbLogCapture() : previous_(std::cerr.rdbuf(held_.rdbuf())) {}
+
+OpenVdbLogCapture::~OpenVdbLogCapture() {
+    if (previous_) std::cerr.rdbuf(previous_);
+}
+
+void OpenVdbLogCapture::keep() {
+    if (!previous_) return;
+    std::cerr.rdbuf(previous_);
+    previous_ = nullptr;
+    std::cerr << held_.str();
+}
+
+void readInChildProcess(const std::string& path, const std::function<void()>& read) {
+    int fds[2];
+    if (::pipe(fds) != 0) throw Error(path + ": cannot check the file (pipe failed)");
+    std::cout.flush();
+    std::cerr.flush();
+    const pid_t pid = ::fork();
+    if (pid < 0) {
+        ::close(fds[0]);
+        ::close(fds[1]);
+        throw Error(path + ": cannot check the file (fork failed)");
+    }
+    if (pid == 0) {  // the child: read, report, and leave without running any destructor
+        ::close(fds[0]);
+        std::ostringstream quiet;
+        std::cerr.rdbuf(quiet.rdbuf());  // the parent's own read reports OpenVDB's warnings
+        std::string message;
+        try {
+            read();
+        } catch (const std::exception& e) {
+            message = e.what();
+        } catch (...) {
+            message = path + ": corrupt VDB file";
+        }
+        for (size_t done = 0; done < message.size();) {
+            const ssize_t n = ::write(fds[1], message.data() + done, message.size() - done);
+            if (n <= 0) break;
+            done += size_t(n);
+        }
+        ::_exit(message.empty() ? 0 : 1);
+    }
+    ::close(fds[1]);
+    std::string message;
+    char buffer[4096];
+    for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) != 0;) {
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) break;
+        if (message.size() < 4096) message.append(buffer, size_t(n));
+    }
+    ::close(fds[0]);
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
+    if (WIFEXITED(status) && !message.empty()) throw Error(message);
+    const int signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+    throw Error(path + ": corrupt VDB file (OpenVDB's reader crashed on it: " +
+                (signal ? "signal " + std::to_string(signal) : "exit " + std::to_string(WEXITSTATUS(status))) + ")");
 }
 
 }  // namespace vdbsplat

@@ -4,7 +4,17 @@
 // allocations, megabyte error messages) or report "0 grids". This walks the header,
 // the file metadata and every grid descriptor (all length-prefixed) and checks that
 // each grid's recorded end offset lies inside the file, reading only a few hundred bytes.
+// Also owns openVdbFile (the pre-check, then OpenVDB's open), OpenVdbLogCapture, which
+// keeps OpenVDB's own log lines (it writes "WARNING: …" to std::cerr) out of the one-line
+// error a bad file gets, and readInChildProcess: OpenVDB's reader can corrupt its heap on
+// damaged leaf data (a flipped byte in a compressed chunk header, found by fuzzing), which
+// no pre-check short of a second VDB reader can rule out, so the read is tried first in a
+// forked child, where a crash becomes a one-line error instead of an abort.
 #pragma once
+#include <openvdb/io/File.h>
+
+#include <functional>
+#include <sstream>
 #include <string>
 
 namespace vdbsplat {
@@ -12,5 +22,33 @@ namespace vdbsplat {
 /// @brief Checks that @p path looks like a complete VDB file (magic, header, descriptors, grid extents).
 /// @throw Error "<path>: not a VDB file …" or "<path>: truncated or corrupt VDB file (…)".
 void checkVdbStructure(const std::string& path);
+
+/// @brief Checks that @p path exists and is a regular file, runs checkVdbStructure, then
+/// opens @p file without delayed loading (so a truncated file fails here, not mid-render).
+/// @throw Error naming @p path: no such file, not a regular file, not a VDB, truncated.
+void openVdbFile(openvdb::io::File& file, const std::string& path);
+
+/// @brief Runs @p read (OpenVDB reads of @p path that throw Error on failure) in a forked
+/// child process first; returns when it succeeded there, so the caller can read for real.
+/// @throw Error with the child's message when @p read threw there, or
+/// "<path>: corrupt VDB file (OpenVDB's reader crashed on it: signal N)" when it died.
+void readInChildProcess(const std::string& path, const std::function<void()>& read);
+
+/// @brief While alive, what is written to std::cerr (OpenVDB's log) is held back. keep()
+/// writes it out and ends the capture (call it once the read succeeded); destroyed
+/// without keep() — the read threw and its Error says what went wrong — it is dropped.
+/// Redirects a process-wide stream: use on the thread that loads, around the reads only.
+class OpenVdbLogCapture {
+public:
+    OpenVdbLogCapture();
+    ~OpenVdbLogCapture();
+    OpenVdbLogCapture(const OpenVdbLogCapture&) = delete;
+    OpenVdbLogCapture& operator=(const OpenVdbLogCapture&) = delete;
+    void keep();
+
+private:
+    std::ostringstream held_;
+    std::streambuf* previous_ = nullptr;
+};
 
 }  // namespace vdbsplat
