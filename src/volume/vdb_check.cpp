@@ -19,6 +19,7 @@
 #include <iostream>
 #include <utility>
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -227,8 +228,13 @@ void readInChildProcess(const std::string& path, const std::function<void()>& re
     }
     if (pid == 0) {  // the child: read, report, and leave without running any destructor
         ::close(fds[0]);
+        // Silence the child: the parent's own read reports OpenVDB's warnings, and glibc's
+        // "free(): invalid size" on a heap OpenVDB corrupted must not add a line either
+        // (LIBC_FATAL_STDERR_ keeps it off the terminal, the null fd 2 swallows it).
         std::ostringstream quiet;
-        std::cerr.rdbuf(quiet.rdbuf());  // the parent's own read reports OpenVDB's warnings
+        std::cerr.rdbuf(quiet.rdbuf());
+        ::setenv("LIBC_FATAL_STDERR_", "1", 1);
+        if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) ::dup2(null, 2);
         std::string message;
         try {
             read();
