@@ -59,6 +59,35 @@ openvdb::FloatGrid::Ptr smallGrid(const std::string& name = "density") {
     return g;
 }
 
+// The grid-header pre-check accepts what OpenVDB writes in every flavour vdbsplat may meet:
+// float grids saved as half floats ("Tree_float_5_4_3_HalfFloat"), double, int and vector
+// grids, active tiles at the root, translated and rotated transforms.
+TEST_F(Grid, HeaderCheckAcceptsEveryWrittenFlavour) {
+    auto half = smallGrid("half");
+    half->setSaveFloatAsHalf(true);
+    auto dbl = openvdb::DoubleGrid::create(0.0);
+    dbl->setName("double");
+    dbl->tree().setValueOn(Coord(3, 4, 5), 0.5);
+    dbl->tree().addTile(3, Coord(0), 0.25, true);  // a root-level active tile
+    auto ints = openvdb::Int32Grid::create(0);
+    ints->setName("ints");
+    ints->tree().setValueOn(Coord(-7, 1, 2), 9);
+    auto vel = openvdb::Vec3SGrid::create();
+    vel->setName("vel");
+    vel->tree().setValueOn(Coord(1, 2, 3), openvdb::Vec3s(1, 2, 3));
+    auto moved = smallGrid("moved");
+    openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
+    m.setToRotation(openvdb::math::Vec3d(0, 0, 1), 0.3);
+    m.setTranslation(openvdb::math::Vec3d(1, 2, 3));
+    moved->setTransform(openvdb::math::Transform::createLinearTransform(m));
+    const std::string file = write("flavours.vdb", {half, dbl, ints, vel, moved});
+    EXPECT_NO_THROW(describeFile(file));
+    for (const char* name : {"half", "double", "moved"}) {
+        const Volume v = loadVolume(file, name);
+        EXPECT_GT(v.activeVoxels, 0u) << name;
+    }
+}
+
 TEST_F(Grid, SmokeVdbDoubleGridLoads) {
     const std::string gz = std::string(VDBSPLAT_SHARED_DIR) + "/volumes/smoke.vdb.gz";
     if (!fs::exists(gz)) GTEST_SKIP() << "../shared/volumes/smoke.vdb.gz is absent";
