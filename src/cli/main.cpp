@@ -35,10 +35,6 @@ int dispatch(const std::string& command, const vdbsplat::cli::Argv& args) {
     throw vdbsplat::Error("unknown command '" + command + "' (try: vdbsplat --help)");
 }
 
-}  // namespace
-
-namespace {
-
 /// The message on one line: control characters (a newline in a corrupt file's grid name,
 /// say) are written as \n, \t or \xHH, and past 1000 characters it is cut with "…".
 std::string oneLine(const std::string& message) {

@@ -17,6 +17,36 @@ namespace {
 
 bool isScalarType(const std::string& type) { return type == "float" || type == "double"; }
 
+/// Opens @p path and reads the grid to render: @p gridName, or the first float or double grid.
+openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::string& gridName) {
+    openvdb::io::File file(path);
+    openVdbFile(file, path);
+    openvdb::GridBase::Ptr base;
+    try {
+        const auto metas = file.readAllGridMetadata();
+        std::string chosen;
+        for (const auto& meta : *metas) {
+            if (!gridName.empty() ? meta->getName() == gridName : isScalarType(meta->valueType())) {
+                if (!isScalarType(meta->valueType()))
+                    throw Error(path + ": grid '" + gridName + "' holds " + meta->valueType() +
+                                " values; only float and double grids can be rendered");
+                chosen = meta->getName();
+                break;
+            }
+        }
+        if (chosen.empty() && !gridName.empty()) throw Error(path + ": no grid named '" + gridName + "'");
+        if (chosen.empty() && metas->empty()) throw Error(path + ": file holds no grids");
+        if (chosen.empty()) throw Error(path + ": no float or double grid in the file");
+        base = file.readGrid(chosen);
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(path + ": corrupt or truncated VDB file (" + std::string(e.what()) + ")");
+    }
+    file.close();
+    return base;
+}
+
 /// Converts a double grid to a float grid of the same topology, transform and metadata.
 openvdb::FloatGrid::Ptr toFloatGrid(const openvdb::GridBase::Ptr& base) {
     if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) return f;
@@ -103,40 +133,6 @@ Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label) {
     sanitizeValues(v);
     return v;
 }
-
-namespace {
-
-/// Opens @p path and reads the grid to render: @p gridName, or the first float or double grid.
-openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::string& gridName) {
-    openvdb::io::File file(path);
-    openVdbFile(file, path);
-    openvdb::GridBase::Ptr base;
-    try {
-        const auto metas = file.readAllGridMetadata();
-        std::string chosen;
-        for (const auto& meta : *metas) {
-            if (!gridName.empty() ? meta->getName() == gridName : isScalarType(meta->valueType())) {
-                if (!isScalarType(meta->valueType()))
-                    throw Error(path + ": grid '" + gridName + "' holds " + meta->valueType() +
-                                " values; only float and double grids can be rendered");
-                chosen = meta->getName();
-                break;
-            }
-        }
-        if (chosen.empty() && !gridName.empty()) throw Error(path + ": no grid named '" + gridName + "'");
-        if (chosen.empty() && metas->empty()) throw Error(path + ": file holds no grids");
-        if (chosen.empty()) throw Error(path + ": no float or double grid in the file");
-        base = file.readGrid(chosen);
-    } catch (const Error&) {
-        throw;
-    } catch (const std::exception& e) {
-        throw Error(path + ": corrupt or truncated VDB file (" + std::string(e.what()) + ")");
-    }
-    file.close();
-    return base;
-}
-
-}  // namespace
 
 Volume loadVolume(const std::string& path, const std::string& gridName) {
     initOpenVdb();

@@ -67,12 +67,6 @@ public:
         pos_ += n;
         return text;
     }
-    /// Back to @p to, a position already passed (seek only goes forward).
-    void rewind(uint64_t to) {
-        pos_ = std::min(to, size_);
-        in_.clear();
-        in_.seekg(std::streamoff(pos_));
-    }
     void seek(uint64_t to, const char* what) {
         if (to < pos_ || to > size_) corrupt(what);
         pos_ = to;
@@ -133,7 +127,6 @@ uint64_t valueBytes(const std::string& gridType) {
 /// (a flipped high byte of a count made OpenVDB loop 3.5 billion times: a minute).
 void checkGridHeader(Reader& r, uint32_t version, const std::string& gridType, uint64_t gridPos,
                      uint64_t blockPos) {
-    const uint64_t resume = r.pos();
     r.seek(gridPos, "grid offset");
     r.limit(blockPos);
     if (version >= kGridCompressionVersion) r.value<uint32_t>("grid compression flags");
@@ -150,8 +143,7 @@ void checkGridHeader(Reader& r, uint32_t version, const std::string& gridType, u
             if ((tiles + children) * 13 > blockPos - r.pos()) r.corrupt("root node tile or child count");
         }
     }
-    r.limit(r.size());
-    r.rewind(resume);
+    r.limit(r.size());  // the caller goes on forward, to the grid's end (≥ blockPos)
 }
 
 void checkGridDescriptors(Reader& r, uint32_t version) {
