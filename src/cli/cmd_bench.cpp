@@ -55,6 +55,7 @@ const char* kHelp =
     "  --view-dir X,Y,Z     framing direction, centre to eye (default 0.9,-1.3,0.75)\n"
     "  --up X,Y,Z           up vector (default 0,0,1)\n"
     "  --threshold PX       minification threshold of hybrid mode in pixels (default 1)\n"
+    "  --lod PX             level-of-detail cell size in pixels (default 1; 0: off; see render --help)\n"
     "  --footprint P        auto (default) | table | exact (see render --help)\n"
     "  --json FILE.json     also write every run, the per-stage medians and the ratios as JSON\n"
     "  -v                   print each run to stderr and the per-stage medians to stdout\n";
@@ -138,6 +139,7 @@ Options optionsFrom(const Args& args) {
     if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
+    if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
     if (auto v = args.get("--view-dir")) {
         const auto d = parseDoubleList(*v, "--view-dir", 3);
         s.camera.hasViewDir = true;
@@ -203,7 +205,7 @@ std::string formatDistance(double d) {
 int runBench(const Argv& argv) {
     const Args args(argv,
                     {"--grid", "--tf", "--size", "--runs", "--warmup", "--threads", "--modes", "--distances",
-                     "--threshold", "--footprint", "--json", "--view-dir", "--up"},
+                     "--threshold", "--lod", "--footprint", "--json", "--view-dir", "--up"},
                     {"-v"});
     if (args.wantsHelp()) {
         std::cout << kHelp;

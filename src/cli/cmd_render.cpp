@@ -36,6 +36,9 @@ const char* kHelp =
     "  --fov DEG          vertical field of view (default 30)\n"
     "  --distance K       multiplies the framing distance (8 far, 1 framed, 0.35 close)\n"
     "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
+    "  --lod PX           level of detail: points are merged into aggregates of 2^3, 4^3 or 8^3 voxels\n"
+    "                     (same total optical depth, centroid and spread) whose side projects to at\n"
+    "                     most PX pixels (default 1; 0 turns it off)\n"
     "  --footprint P      auto (default): the (i, alpha) reindex table, and the exact ray-centre\n"
     "                     distance for splats far off the axis where the affine index is off;\n"
     "                     table: the reindex table for every splat; exact: closed form per pixel\n"
@@ -65,6 +68,7 @@ RenderSettings settingsFrom(const Args& args) {
     if (auto v = args.get("--spp")) s.spp = int(parseInt(*v, "--spp", 1, 1024));
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
+    if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
     s.showPrimitives = args.has("--show-primitives");
     if (auto v = args.get("--tables")) {
         if (v->empty()) throw Error("--tables: expected a directory, got ''");
@@ -117,7 +121,7 @@ std::string oneLine(const RenderStats& st, const RenderSettings& s) {
 int runRender(const Argv& argv) {
     const Args args(argv,
                     {"-o", "--grid", "--mode", "--size", "--tf", "--eye", "--look-at", "--up", "--view-dir", "--fov", "--distance",
-                     "--threads", "--spp", "--stats", "--threshold", "--footprint", "--tables"},
+                     "--threads", "--spp", "--stats", "--threshold", "--lod", "--footprint", "--tables"},
                     {"-v", "--show-primitives"});
     if (args.wantsHelp()) {
         std::cout << kHelp;

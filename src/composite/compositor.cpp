@@ -93,6 +93,7 @@ SkippedPrimitives TileCompositor::composite(const std::vector<Primitive>& prims,
         if (!any) {
             ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
             if (p.kind == PrimitiveKind::SplatExactIndex) ++skipped.exactIndexSplats;
+            skipped.voxels += p.members;
         }
     }
     binSeconds += since(t0);

@@ -37,6 +37,7 @@ struct ExactContext {
 struct SkippedPrimitives {
     uint64_t points = 0, splats = 0;
     uint64_t exactIndexSplats = 0;  ///< of the splats: SplatExactIndex
+    uint64_t voxels = 0;            ///< active voxels the skipped primitives stand for
 };
 
 class TileCompositor {

@@ -27,6 +27,7 @@ struct Primitive {
     PrimitiveKind kind = PrimitiveKind::Culled;
     int64_t slab = 0;           ///< depth slab (points of one slab are summed before compositing)
     float depth = 0.f;          ///< radial distance of the voxel centre (world units): the order
+    uint32_t members = 1;       ///< active voxels it stands for (a level-of-detail aggregate: more)
     PixelRange range;           ///< the image pixels it may touch (clamped)
     glm::vec3 color{0.f};       ///< emitted colour (already tinted for --show-primitives)
     glm::vec2 centre{0.f};      ///< point position / ellipse centre (pixels)

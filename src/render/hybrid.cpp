@@ -1,7 +1,9 @@
 // render/hybrid.cpp — window-by-window forward resampling (see hybrid.h).
 #include "render/hybrid.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "composite/compositor.h"
 #include "render/project.h"
@@ -16,13 +18,19 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     const Tables& tables, const RenderSettings& settings, RenderStats& stats) {
-    VoxelStream stream(volume, camera, table, settings.stream);
+    StreamOptions streamOptions = settings.stream;
+    streamOptions.lodCellPx = settings.lodPx;
+    streamOptions.pointBelowPx = settings.mode == RenderMode::Point   ? INFINITY
+                                 : settings.mode == RenderMode::Splat ? 0.0
+                                                                      : settings.threshold;
+    VoxelStream stream(volume, camera, table, streamOptions);
     TileCompositor compositor(camera.width(), camera.height(), tables, ExactContext{&camera, volume.voxelSize});
     const ProjectionContext ctx{camera,          tables,           volume.voxelSize,  stream.slabLength(),
                                 settings.mode,   settings.threshold, settings.footprint, settings.showPrimitives};
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
     std::vector<Primitive> prims;
+    uint64_t drawnVoxels = 0;
     while (true) {
         auto t = Clock::now();
         if (!stream.next(batch, hidden)) break;
@@ -33,16 +41,24 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
             if (p.kind == PrimitiveKind::Point) ++stats.points;
             else if (p.kind != PrimitiveKind::Culled) ++stats.splats;
             if (p.kind == PrimitiveKind::SplatExactIndex) ++stats.exactIndexSplats;
+            if (p.kind != PrimitiveKind::Culled) {
+                drawnVoxels += p.members;
+                if (p.members > 1) ++stats.lodAggregates, stats.lodVoxels += p.members;
+            }
         }
         stats.projectSeconds += since(t);
         const SkippedPrimitives hiddenPrims = compositor.composite(prims, stats.rasterizeSeconds, stats.compositeSeconds);
         stats.points -= hiddenPrims.points;
         stats.splats -= hiddenPrims.splats;
         stats.exactIndexSplats -= hiddenPrims.exactIndexSplats;
+        drawnVoxels -= hiddenPrims.voxels;
+        stats.culledHidden += hiddenPrims.voxels;
     }
     // Everything else drew nothing: outside the frustum, behind opaque tiles, off screen,
     // or transparent under the transfer function.
-    stats.culled = volume.activeVoxels - stats.points - stats.splats;
+    stats.culled = volume.activeVoxels - std::min<uint64_t>(volume.activeVoxels, drawnVoxels);
+    stats.culledFrustum = stream.counts().frustum;
+    stats.culledOccluded = stream.counts().occluded;
     stats.windows = stream.windows();
     stats.largestWindow = stream.largestWindow();
     return compositor.image();

@@ -21,13 +21,13 @@ glm::vec3 splatTint(const glm::vec3& c) {
     return glm::vec3(1.0f, 0.12f, 0.12f) * luma;
 }
 
-Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, const ProjectionContext& ctx) {
+Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float spreadPx2, const ProjectionContext& ctx) {
     Primitive p;
     const PixelCoord centre = ctx.camera.project(c);
     if (!std::isfinite(centre.x) || !std::isfinite(centre.y)) return p;
     p.kind = PrimitiveKind::Point;
     p.centre = glm::vec2(centre);
-    p.variance = float(pointFilterVariance(spacingPx));
+    p.variance = float(pointFilterVariance(spacingPx) + spreadPx2);  // + an aggregate's spread (DESIGN §8.2)
     // σ·M·(f/z)²·(D/z) with σ per world unit = sigma / h (DESIGN §4).
     p.total = float(pointDepositTotal(sigma / ctx.voxelSize, ctx.voxelSize, ctx.camera.focal(), c));
     PixelBox box;
@@ -70,12 +70,13 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
 
 }  // namespace
 
-Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx) {
+Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx,
+                       float spreadPx2) {
     const double spacingPx = c.z > 0.0 ? ctx.voxelSize * ctx.camera.focal() / c.z : INFINITY;
     const bool point = ctx.mode == RenderMode::Point ? c.z > 0.0
                        : ctx.mode == RenderMode::Splat ? false
                                                        : spacingPx < ctx.threshold;
-    Primitive p = point ? makePoint(c, sigma, spacingPx, ctx) : makeSplat(c, sigma, ctx);
+    Primitive p = point ? makePoint(c, sigma, spacingPx, spreadPx2, ctx) : makeSplat(c, sigma, ctx);
     p.color = (!point && ctx.showPrimitives) ? splatTint(color) : color;
     return p;
 }
@@ -84,7 +85,8 @@ void projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, std::ve
     prims.resize(batch.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
-            Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx);
+            Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
+            p.members = batch.members[i];
             p.depth = batch.distance[i];
             p.slab = std::clamp<int64_t>(int64_t(std::floor(batch.distance[i] / ctx.slabLength)), batch.slabBegin,
                                          batch.slabEnd - 1);

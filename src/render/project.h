@@ -35,6 +35,9 @@ struct ProjectionContext {
 void projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, std::vector<Primitive>& prims);
 
 /// @brief Projects one voxel (view-space centre @p c, extinction per voxel length @p sigma).
-Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx);
+/// @param spreadPx2 a level-of-detail aggregate's projected second moment (px², added to
+/// the point filter's variance; 0 for a single voxel).
+Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx,
+                       float spreadPx2 = 0.f);
 
 }  // namespace vdbsplat

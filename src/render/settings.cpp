@@ -36,6 +36,8 @@ void RenderSettings::validate() const {
     if (threads < 0 || threads > 1024) throw Error("--threads: must be in [0, 1024]");
     if (spp < 1 || spp > 1024) throw Error("--spp: must be in [1, 1024]");
     if (!(std::isfinite(threshold) && threshold > 0.0)) throw Error("--threshold: must be a positive number of pixels");
+    if (!(std::isfinite(lodPx) && lodPx >= 0.0 && lodPx <= 64.0))
+        throw Error("--lod: must be a number of pixels in [0, 64] (0 turns level of detail off)");
     if (!tablesDir.empty()) {
         std::error_code ec;
         if (!std::filesystem::is_directory(tablesDir, ec))
@@ -83,6 +85,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["threshold"] = threshold;
     j["footprint"] = toString(footprint);
     j["show_primitives"] = showPrimitives;
+    j["lod"] = lodPx;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
     return j;
 }
@@ -94,6 +97,11 @@ nlohmann::json RenderStats::toJson() const {
     j["points"] = points;
     j["splats"] = splats;
     j["culled"] = culled;
+    j["culled_by"] = {{"frustum", culledFrustum}, {"occluded_blocks", culledOccluded},
+                      {"hidden_at_tiles", culledHidden},
+                      {"other", culled - std::min(culled, culledFrustum + culledOccluded + culledHidden)}};
+    j["lod_aggregates"] = lodAggregates;
+    j["lod_voxels"] = lodVoxels;
     j["splats_exact_index"] = exactIndexSplats;
     j["windows"] = windows;
     j["largest_window_voxels"] = largestWindow;

@@ -38,6 +38,9 @@ struct RenderSettings {
     double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
     FootprintPath footprint = FootprintPath::Auto;
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
+    /// Level of detail for minified voxels (DESIGN §8.2): points are aggregated over cells of
+    /// 2, 4 or 8 voxels per side whose side projects to at most this many pixels; 0: off.
+    double lodPx = 1.0;
     std::string tablesDir;                  ///< footprint/reindex tables; empty: defaultTablesDir()
     StreamOptions stream;                   ///< how the grid is streamed: speed and memory, never the image
 
@@ -52,6 +55,11 @@ struct RenderStats {
     uint64_t points = 0, splats = 0;  ///< primitives drawn (not hidden behind opaque tiles)
     uint64_t exactIndexSplats = 0;    ///< of the splats: drawn with the exact index (--footprint auto)
     uint64_t culled = 0;              ///< active voxels that drew nothing (frustum, occlusion, off screen, σ = 0)
+    uint64_t culledFrustum = 0;       ///< of those: in blocks outside the view frustum or behind the eye
+    uint64_t culledOccluded = 0;      ///< ... in blocks behind opaque tiles, never classified or projected
+    uint64_t culledHidden = 0;        ///< ... projected, then dropped: every tile they touch was opaque
+    uint64_t lodAggregates = 0;       ///< level-of-detail points drawn for aggregates of voxels
+    uint64_t lodVoxels = 0;           ///< active voxels those aggregates stand for
     uint64_t windows = 0;             ///< forward modes: depth windows streamed
     uint64_t largestWindow = 0;       ///< forward modes: most voxels in one window
     uint64_t rays = 0;  ///< reference: rays traced

@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "footprint/kernel.h"
@@ -27,6 +28,8 @@ void VoxelBatch::clear() {
     distance.clear();
     sigma.clear();
     color.clear();
+    spread.clear();
+    members.clear();
 }
 
 VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
@@ -36,6 +39,16 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
     if (volume.activeVoxels > kMaxActiveVoxels)
         throw Error(volume.file + ": grid '" + volume.name + "' has " + std::to_string(volume.activeVoxels) +
                     " active voxels, more than the 2^32 vdbsplat streams");
+    // view = R·(world − eye) with rows right, up, forward.
+    glm::dmat4 worldToView(1.0);
+    const glm::dvec3 r = camera_.right(), u = camera_.up(), f = camera_.forward();
+    for (int c = 0; c < 3; ++c) {
+        worldToView[c][0] = r[c];
+        worldToView[c][1] = u[c];
+        worldToView[c][2] = f[c];
+    }
+    worldToView[3] = glm::dvec4(-glm::dot(r, camera_.eye()), -glm::dot(u, camera_.eye()), -glm::dot(f, camera_.eye()), 1.0);
+    indexToView_ = worldToView * volume_.indexToWorld;
     collectBlocks();
 }
 
@@ -44,7 +57,7 @@ void VoxelStream::collectBlocks() {
     std::vector<Block> all;
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
         if (leaf->onVoxelCount() == 0) continue;
-        all.push_back({leaf->origin(), kBlockDim, &*leaf, 0.f, 0.f, 0.f, uint32_t(leaf->onVoxelCount())});
+        all.push_back({leaf->origin(), kBlockDim, &*leaf, 0.f, 0.f, 0.f, uint32_t(leaf->onVoxelCount()), 0});
     }
     // Active tiles (values above leaf level): split into virtual 8³ blocks.
     auto it = tree.cbeginValueOn();
@@ -56,7 +69,7 @@ void VoxelStream::collectBlocks() {
             for (int y = box.min().y(); y <= box.max().y(); y += kBlockDim)
                 for (int z = box.min().z(); z <= box.max().z(); z += kBlockDim)
                     all.push_back({openvdb::Coord(x, y, z), kBlockDim, nullptr, *it, 0.f, 0.f,
-                                   uint32_t(kBlockDim * kBlockDim * kBlockDim)});
+                                   uint32_t(kBlockDim * kBlockDim * kBlockDim), 0});
     }
     // Distance bounds of voxel centres: the block's bounding sphere around its centre.
     const double h = volume_.voxelSize;
@@ -69,9 +82,13 @@ void VoxelStream::collectBlocks() {
         b.dMax = float(dist + halfDiagonal);
     }
     blocks_.clear();
-    for (const Block& b : all) {
-        if (visible(b)) blocks_.push_back(b);
-        else culled_ += b.voxels;
+    for (Block& b : all) {
+        if (!visible(b)) {
+            counts_.frustum += b.voxels;
+            continue;
+        }
+        b.lodLevel = lodLevel(b);
+        blocks_.push_back(b);
     }
     // Front to back by nearest distance; ties broken by position so the order is total.
     std::sort(blocks_.begin(), blocks_.end(), [](const Block& a, const Block& b) {
@@ -122,37 +139,108 @@ void VoxelStream::screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1)
     y1 = int(std::clamp(std::ceil(hiy + m), 0.0, double(camera_.height() - 1)));
 }
 
-void VoxelStream::extract(const Block& b, VoxelBatch& out) const {
-    const glm::dmat4 indexToView = [&] {
-        // view = R·(world − eye) with rows right, up, forward.
-        glm::dmat4 worldToView(1.0);
-        const glm::dvec3 r = camera_.right(), u = camera_.up(), f = camera_.forward();
-        for (int c = 0; c < 3; ++c) {
-            worldToView[c][0] = r[c];
-            worldToView[c][1] = u[c];
-            worldToView[c][2] = f[c];
+int VoxelStream::lodLevel(const Block& b) const {
+    if (!(options_.lodCellPx > 0.0) || !(options_.pointBelowPx > 0.0)) return 0;
+    const double h = volume_.voxelSize;
+    const glm::dvec3 centreIdx = glm::dvec3(b.origin.x(), b.origin.y(), b.origin.z()) + 0.5 * (b.dim - 1);
+    const glm::dvec3 c(indexToView_ * glm::dvec4(centreIdx, 1.0));
+    const double zNear = c.z - 0.5 * (b.dim - 1) * std::sqrt(3.0) * h;  // nearest voxel centre's depth, bounded
+    if (!(zNear > 0.0)) return 0;
+    const double spacingPx = h * camera_.focal() / zNear;  // the block's largest projected voxel spacing
+    if (!(spacingPx < options_.pointBelowPx)) return 0;     // some voxel may be a splat
+    int level = 0;
+    while (level < 3 && double(2 << level) * spacingPx <= options_.lodCellPx) ++level;
+    return level;
+}
+
+/// Calls fn(local index (0..dim−1 per axis), value) for every active voxel of the block.
+template <typename Fn>
+void VoxelStream::forEachActive(const Block& b, Fn&& fn) const {
+    if (b.leaf) {
+        const float* values = b.leaf->buffer().data();
+        for (auto it = b.leaf->getValueMask().beginOn(); it; ++it) {
+            const openvdb::Index n = it.pos();  // x·64 + y·8 + z
+            fn(int(n >> 6), int((n >> 3) & 7), int(n & 7), values[n]);
         }
-        worldToView[3] = glm::dvec4(-glm::dot(r, camera_.eye()), -glm::dot(u, camera_.eye()),
-                                    -glm::dot(f, camera_.eye()), 1.0);
-        return worldToView * volume_.indexToWorld;
-    }();
-    const auto emit = [&](const openvdb::Coord& ijk, float value) {
+    } else {
+        for (int x = 0; x < b.dim; ++x)
+            for (int y = 0; y < b.dim; ++y)
+                for (int z = 0; z < b.dim; ++z) fn(x, y, z, b.tileValue);
+    }
+}
+
+void VoxelStream::extract(const Block& b, VoxelBatch& out) const {
+    if (b.lodLevel > 0) return extractAggregates(b, out);
+    const glm::dvec3 origin(b.origin.x(), b.origin.y(), b.origin.z());
+    forEachActive(b, [&](int x, int y, int z, float value) {
         const Classified cls = table_(value);
         if (!(cls.sigma > 0.f)) return;
-        const glm::dvec3 v(indexToView * glm::dvec4(ijk.x(), ijk.y(), ijk.z(), 1.0));
+        const glm::dvec3 v(indexToView_ * glm::dvec4(origin + glm::dvec3(x, y, z), 1.0));
         out.viewPos.emplace_back(v);
         out.distance.push_back(float(glm::length(v)));
         out.sigma.push_back(cls.sigma);
         out.color.push_back(cls.color);
+        out.spread.push_back(0.f);
+        out.members.push_back(1);
+    });
+}
+
+// Level of detail (DESIGN §8.2): one record per cell of s = 2^L voxels per side with the cell's
+// optical-depth mass m = Σσ_k, colour Σσ_k c_k / m, σ-weighted centroid μ and the projected
+// second moment of its voxels about μ. Moments are accumulated about the cell's centre (|offset|
+// ≤ 3.5 voxels) so the float sums do not cancel.
+void VoxelStream::extractAggregates(const Block& b, VoxelBatch& out) const {
+    struct Moments {
+        float m = 0.f;
+        glm::vec3 emission{0.f}, first{0.f};
+        float xx = 0.f, yy = 0.f, zz = 0.f, xy = 0.f, xz = 0.f, yz = 0.f;
+        uint32_t n = 0;
     };
-    if (b.leaf) {
-        for (auto it = b.leaf->cbeginValueOn(); it; ++it) emit(it.getCoord(), *it);
-    } else {
-        openvdb::Coord ijk;
-        for (ijk[0] = b.origin.x(); ijk[0] < b.origin.x() + b.dim; ++ijk[0])
-            for (ijk[1] = b.origin.y(); ijk[1] < b.origin.y() + b.dim; ++ijk[1])
-                for (ijk[2] = b.origin.z(); ijk[2] < b.origin.z() + b.dim; ++ijk[2]) emit(ijk, b.tileValue);
-    }
+    const int level = b.lodLevel, side = 1 << level, cells = b.dim >> level;
+    const float half = 0.5f * float(side - 1);
+    std::array<Moments, 64> acc{};  // cells ≤ (8/2)³
+    forEachActive(b, [&](int x, int y, int z, float value) {
+        const Classified cls = table_(value);
+        if (!(cls.sigma > 0.f)) return;
+        Moments& a = acc[size_t(((x >> level) * cells + (y >> level)) * cells + (z >> level))];
+        const glm::vec3 d(float(x & (side - 1)) - half, float(y & (side - 1)) - half, float(z & (side - 1)) - half);
+        const float s = cls.sigma;
+        a.m += s;
+        a.emission += s * cls.color;
+        a.first += s * d;
+        a.xx += s * d.x * d.x, a.yy += s * d.y * d.y, a.zz += s * d.z * d.z;
+        a.xy += s * d.x * d.y, a.xz += s * d.x * d.z, a.yz += s * d.y * d.z;
+        ++a.n;
+    });
+    const glm::dmat3 toView(indexToView_);  // linear part: index offsets → view offsets
+    const double f = camera_.focal();
+    for (int cx = 0; cx < cells; ++cx)
+        for (int cy = 0; cy < cells; ++cy)
+            for (int cz = 0; cz < cells; ++cz) {
+                const Moments& a = acc[size_t((cx * cells + cy) * cells + cz)];
+                if (!(a.m > 0.f)) continue;
+                const glm::dvec3 mu = glm::dvec3(a.first) / double(a.m);
+                const glm::dvec3 centreIdx = glm::dvec3(b.origin.x() + cx * side, b.origin.y() + cy * side,
+                                                        b.origin.z() + cz * side) + double(half) + mu;
+                const glm::dvec3 v(indexToView_ * glm::dvec4(centreIdx, 1.0));
+                // Covariance about μ (index units²), then in view space: Σ_v = A Σ Aᵀ.
+                const double im = 1.0 / a.m;
+                glm::dmat3 cov;
+                cov[0][0] = a.xx * im - mu.x * mu.x, cov[1][1] = a.yy * im - mu.y * mu.y, cov[2][2] = a.zz * im - mu.z * mu.z;
+                cov[0][1] = cov[1][0] = a.xy * im - mu.x * mu.y;
+                cov[0][2] = cov[2][0] = a.xz * im - mu.x * mu.z;
+                cov[1][2] = cov[2][1] = a.yz * im - mu.y * mu.z;
+                const glm::dmat3 covView = toView * cov * glm::transpose(toView);
+                // Projected (Jacobian of the perspective map at μ, EWA 2001 eq. 25): J = f/z [I | −v.xy/z].
+                const glm::dvec3 jx(f / v.z, 0.0, -f * v.x / (v.z * v.z)), jy(0.0, f / v.z, -f * v.y / (v.z * v.z));
+                const double spread = 0.5 * (glm::dot(jx, covView * jx) + glm::dot(jy, covView * jy));
+                out.viewPos.emplace_back(v);
+                out.distance.push_back(float(glm::length(v)));
+                out.sigma.push_back(a.m);
+                out.color.push_back(a.emission / a.m);
+                out.spread.push_back(float(std::max(spread, 0.0)));
+                out.members.push_back(a.n);
+            }
 }
 
 void VoxelStream::adaptWindow(size_t released) {
@@ -200,11 +288,17 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
         });
         for (size_t i = first; i < nextBlock_; ++i) {
             const VoxelBatch& e = extracted[i - first];
-            if (skipped[i - first]) culled_ += blocks_[i].voxels;
+            if (skipped[i - first]) counts_.occluded += blocks_[i].voxels;
+            if (blocks_[i].lodLevel > 0) {
+                counts_.aggregates += e.size();
+                for (uint32_t n : e.members) counts_.aggregatedVoxels += n;
+            }
             appendRange(pending_.viewPos, e.viewPos, 0, e.size());
             appendRange(pending_.distance, e.distance, 0, e.size());
             appendRange(pending_.sigma, e.sigma, 0, e.size());
             appendRange(pending_.color, e.color, 0, e.size());
+            appendRange(pending_.spread, e.spread, 0, e.size());
+            appendRange(pending_.members, e.members, 0, e.size());
         }
         // Release the pending voxels inside the window; keep the rest in order.
         const float limit = float(slabEnd * slabLength_);
@@ -215,6 +309,8 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
             dst.distance.push_back(pending_.distance[i]);
             dst.sigma.push_back(pending_.sigma[i]);
             dst.color.push_back(pending_.color[i]);
+            dst.spread.push_back(pending_.spread[i]);
+            dst.members.push_back(pending_.members[i]);
         }
         pending_ = std::move(keep);
         batch.slabBegin = nextSlab_;

@@ -8,6 +8,14 @@
 //
 // Each voxel comes out classified (σ per voxel length, colour) and in view space;
 // voxels with σ = 0 are dropped here, so nothing downstream pays for them.
+//
+// Level of detail (DESIGN §8.2): a block whose voxels all project well under a pixel
+// (and under the point threshold, so every one of them would be a point anyway) is
+// released as aggregates of 2³, 4³ or 8³ voxels instead: one record per cell that
+// carries the cell's total optical-depth mass Σσ_k and σ-weighted colour, sits at the
+// σ-weighted centroid, and adds the projected second moment of its voxels about that
+// centroid to the point filter's variance (`spread`). Energy is kept exactly; what an
+// aggregate loses is the ordering of its own voxels in depth (measured in docs/fidelity.md).
 #pragma once
 #include <functional>
 #include <glm/glm.hpp>
@@ -24,7 +32,10 @@ struct VoxelBatch {
     std::vector<glm::vec3> viewPos;  ///< voxel centre in view space (eye at origin, +z forward)
     std::vector<float> distance;     ///< |viewPos|, world units
     std::vector<float> sigma;        ///< extinction per voxel length (σ_k·h)
-    std::vector<glm::vec3> color;    ///< emitted colour c_k
+    std::vector<glm::vec3> color;    ///< emitted colour c_k (σ-weighted mean for an aggregate)
+    std::vector<float> spread;       ///< aggregate: projected second moment about the centroid,
+                                     ///< isotropic (trace/2), px²; 0 for a single voxel
+    std::vector<uint32_t> members;   ///< voxels the record stands for (1, or an aggregate's count)
     int64_t slabBegin = 0;           ///< first slab of the window: slab = floor(distance / (h·slabThickness))
     int64_t slabEnd = 0;             ///< one past the last slab
     size_t size() const { return viewPos.size(); }
@@ -41,6 +52,20 @@ struct StreamOptions {
     /// boundaries are slab boundaries, so the image does not depend on this.
     size_t maxWindowVoxels = 1 << 20;
     double screenMargin = 4.0;   ///< pixels of margin around the image for frustum culling
+    /// Level of detail: aggregate cells of 2^L voxels per side whose side projects to at most
+    /// this many pixels (0: off). Only blocks whose voxels are all points are aggregated.
+    double lodCellPx = 1.0;
+    /// Voxels whose projected spacing h·f/z is under this many pixels are drawn as points by
+    /// the renderer (hybrid: its threshold τ; point mode: +∞; splat mode: 0, no aggregates).
+    double pointBelowPx = 0.0;
+};
+
+/// @brief Counts of what the stream released and what it culled, by cause.
+struct StreamCounts {
+    uint64_t frustum = 0;     ///< voxels of blocks outside the view frustum or behind the eye
+    uint64_t occluded = 0;    ///< voxels of blocks behind opaque screen tiles (never classified)
+    uint64_t aggregates = 0;  ///< level-of-detail records released
+    uint64_t aggregatedVoxels = 0;  ///< active voxels they stand for (σ = 0 voxels excluded)
 };
 
 class VoxelStream {
@@ -55,7 +80,8 @@ public:
     /// x0, y0, x1, y1 inclusive) is entirely behind opaque pixels, so it can be skipped.
     bool next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden = {});
 
-    uint64_t culledVoxels() const { return culled_; }   ///< voxels in blocks culled so far
+    uint64_t culledVoxels() const { return counts_.frustum + counts_.occluded; }  ///< voxels in culled blocks
+    const StreamCounts& counts() const { return counts_; }
     uint64_t windows() const { return windows_; }        ///< windows released so far
     size_t largestWindow() const { return largest_; }    ///< most voxels in one window so far
     double slabLength() const { return slabLength_; }    ///< world length of one slab
@@ -68,11 +94,15 @@ private:
         float tileValue;
         float dMin, dMax;               // distance range of its voxel centres (world)
         uint32_t voxels;                // active voxels
+        int lodLevel;                   // 0: voxel by voxel; L ≥ 1: aggregates of (2^L)³ cells
     };
     void collectBlocks();
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
+    int lodLevel(const Block& b) const;
     void extract(const Block& b, VoxelBatch& out) const;
+    void extractAggregates(const Block& b, VoxelBatch& out) const;
+    template <typename Fn> void forEachActive(const Block& b, Fn&& fn) const;
     void adaptWindow(size_t released);  // the next window's slab count from this one's size
 
     const Volume& volume_;
@@ -85,7 +115,8 @@ private:
     VoxelBatch pending_;          // voxels of activated blocks not yet released
     int64_t nextSlab_ = 0;
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
-    uint64_t culled_ = 0;
+    glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)
+    StreamCounts counts_;
     uint64_t windows_ = 0;
     size_t largest_ = 0;
 };
