@@ -49,7 +49,7 @@ declare -A CONVERT=(
 declare -A ACTIVE=([engine]=1328027 [bonsai]=1955550 [smoke]=524288)
 
 usage() {
-  sed -n '4,10p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '/^# usage:/,/^# The binary/p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
 }
 
 # --- Arguments ----------------------------------------------------------------------------------
@@ -144,7 +144,10 @@ obtain() {
       tried+=("$url: sha256 mismatch (expected $want, got $got)")
       got=""
     done
-    [[ ${got:-} == "$want" ]] || die "$file: no source gave the right file ($(IFS=';'; echo "${tried[*]}")); refusing it"
+    if [[ ${got:-} != "$want" ]]; then
+      local why; why=$(printf '%s; ' "${tried[@]}")
+      die "$file: no source gave the right file (${why%; }); refusing it"
+    fi
   fi
   chmod "$MODE" "$part"
   mv -f -- "$part" "$dst"
@@ -158,19 +161,20 @@ activeOf() {
 
 # Converts (or copies) the checked file of volume $1 into $OUT/$1.vdb and checks its count.
 convert_one() {
-  local n=$1 src=$OUT/downloads/${FILE[$1]} dst=$OUT/$1.vdb tmp active
+  local n=$1 src=$OUT/downloads/${FILE[$1]} dst=$OUT/$1.vdb tmp active err
   tmp=$(mktemp "$OUT/.$n.XXXXXX.vdb")
   TEMPS+=("$tmp")
   # Re-check: the file was verified in this run, but nothing reads it unverified.
   [[ $(sha256of "$src") == "${SHA256[$n]}" ]] || die "$src: changed since it was checked; refusing it"
   if [[ -n ${CONVERT[$n]} ]]; then
     # shellcheck disable=SC2086  # the flags are words
-    "$VDBSPLAT" convert "$src" -o "$tmp" ${CONVERT[$n]} >/dev/null || die "$src: vdbsplat convert failed"
+    err=$("$VDBSPLAT" convert "$src" -o "$tmp" ${CONVERT[$n]} 2>&1 >/dev/null) ||
+      die "$src: vdbsplat convert failed: ${err#vdbsplat: error: }"
   else
     cp -- "$src" "$tmp"
   fi
   if [[ -x $VDBSPLAT ]]; then
-    active=$(activeOf "$tmp") || die "$dst: vdbsplat info failed"
+    active=$(activeOf "$tmp" 2>/dev/null) || die "$dst: vdbsplat info cannot read the result"
     [[ $active == "${ACTIVE[$n]}" ]] || die "$dst: $active active voxels, the catalogue says ${ACTIVE[$n]}"
   fi
   chmod "$MODE" "$tmp"

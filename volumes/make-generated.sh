@@ -36,7 +36,7 @@ declare -A ACTIVE=(
 )
 
 usage() {
-  sed -n '4,10p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '/^# usage:/,/^# The binary/p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
 }
 
 OUT=$ROOT/volumes
@@ -73,8 +73,10 @@ for n in "${WANT[@]}"; do
   TEMPS+=("$tmp")
   read -r kind args <<<"${ARGS[$n]}"
   # shellcheck disable=SC2086  # the flags are words
-  "$VDBSPLAT" generate "$kind" -o "$tmp" $args >/dev/null || die "$dst: vdbsplat generate failed"
-  active=$("$VDBSPLAT" info "$tmp" | sed -n 's/^ *active voxels: *\([0-9]*\).*/\1/p' | head -1)
+  err=$("$VDBSPLAT" generate "$kind" -o "$tmp" $args 2>&1 >/dev/null) ||
+    die "$dst: vdbsplat generate failed: ${err#vdbsplat: error: }"
+  active=$("$VDBSPLAT" info "$tmp" 2>/dev/null | sed -n 's/^ *active voxels: *\([0-9]*\).*/\1/p' | head -1) ||
+    die "$dst: vdbsplat info cannot read the result"
   [[ $active == "${ACTIVE[$n]}" ]] || die "$dst: $active active voxels, the catalogue says ${ACTIVE[$n]}"
   mv -f -- "$tmp" "$dst"
   echo "make-generated: wrote $dst (${ACTIVE[$n]} active voxels)"
