@@ -5,7 +5,7 @@
 # usage: volumes/make-generated.sh [--out DIR] [NAME... | all]
 #   NAME       checkerbox, marschner-lobb, sphere, cloud (no NAME or "all": these four),
 #              cloud-20m, cloud-100m (the large grids of docs/performance.md, only when
-#              named: 0.3 and 1.2 GB files)
+#              named: 66 MB and 314 MB files)
 #   --out DIR  where the .vdb files go (default: volumes/)
 # The binary is $VDBSPLAT, else ${BUILD_DIR:-build}/vdbsplat (run scripts/build.sh first).
 # Output is the same on every run; each file is written to a temporary file and renamed.
@@ -32,7 +32,7 @@ declare -A ACTIVE=(
   [sphere]=130536
   [cloud]=1000002
   [cloud-20m]=19999990
-  [cloud-100m]=0
+  [cloud-100m]=99999970
 )
 
 usage() {
