@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # The fidelity table of docs/fidelity.md: PSNR/SSIM of hybrid, splat and point against the
 # reference renderer for the checker box, Marschner-Lobb and the converted Engine at the
-# three standard views (--distance 8, 1, 0.35), 400x400. Reference images are cached in
-# out/fidelity/ (delete them to re-render). Usage: scripts/fidelity.sh [--spp N]
+# three standard views (--distance 8, 1, 0.35), 400x400. The volumes come from volumes/
+# (volumes/README.md): the generated ones are made there when missing, the Engine is
+# volumes/engine.vdb from volumes/fetch.sh (its rows are skipped when it is absent).
+# Reference images are cached in out/fidelity/ (delete them to re-render).
+# Usage: scripts/fidelity.sh [--spp N]
 # Writes out/fidelity/fidelity.md (a Markdown table) and out/fidelity/fidelity.tsv.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,18 +14,17 @@ SPP=16
 scripts/build.sh >/dev/null
 BIN=${BUILD_DIR:-build}/vdbsplat
 OUT=out/fidelity
+VOLS=volumes
 mkdir -p "$OUT"
-ENGINE=../shared/volumes/engine_256x256x128_uint8.raw.gz
 
-[[ -f $OUT/checkerbox.vdb ]] || "$BIN" generate checkerbox -o $OUT/checkerbox.vdb >/dev/null
-[[ -f $OUT/marschner-lobb.vdb ]] || "$BIN" generate marschner-lobb -o $OUT/marschner-lobb.vdb >/dev/null
+for vol in checkerbox marschner-lobb; do
+  [[ -f $VOLS/$vol.vdb ]] || VDBSPLAT=$BIN volumes/make-generated.sh $vol >/dev/null
+done
 VOLUMES="checkerbox:grey marschner-lobb:grey"
-if [[ -f $ENGINE ]]; then
-  [[ -f $OUT/engine.vdb ]] || "$BIN" convert $ENGINE -o $OUT/engine.vdb --dims 256,256,128 --type uint8 \
-      --threshold 0.1176 >/dev/null
+if [[ -f $VOLS/engine.vdb ]]; then
   VOLUMES="$VOLUMES engine:ct-bone"
 else
-  echo "fidelity: $ENGINE absent, skipping the Engine rows" >&2
+  echo "fidelity: $VOLS/engine.vdb absent (run volumes/fetch.sh engine), skipping the Engine rows" >&2
 fi
 
 printf "volume\tdistance\tmode\tpsnr_db\tssim\tsplat_pct\tseconds\n" > $OUT/fidelity.tsv
@@ -31,12 +33,12 @@ for entry in $VOLUMES; do
   for d in 8 1 0.35; do
     ref=$OUT/${vol}_d${d}_reference.exr
     if [[ ! -f $ref ]]; then
-      "$BIN" render $OUT/$vol.vdb -o $ref --mode reference --tf $tf --distance $d --spp $SPP \
+      "$BIN" render $VOLS/$vol.vdb -o $ref --mode reference --tf $tf --distance $d --spp $SPP \
           --stats $OUT/${vol}_d${d}_reference.json
     fi
     for mode in hybrid splat point; do
       img=$OUT/${vol}_d${d}_${mode}.exr
-      "$BIN" render $OUT/$vol.vdb -o $img --mode $mode --tf $tf --distance $d --stats $OUT/stats.json
+      "$BIN" render $VOLS/$vol.vdb -o $img --mode $mode --tf $tf --distance $d --stats $OUT/stats.json
       m=$("$BIN" compare $img $ref)
       psnr=$(sed -E 's/.*psnr=([^ ]+) dB.*/\1/' <<<"$m")
       ssim=$(sed -E 's/.*ssim=([^ ]+) .*/\1/' <<<"$m")

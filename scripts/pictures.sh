@@ -1,29 +1,30 @@
 #!/usr/bin/env bash
 # The pictures of docs/fidelity.md and the README: the Engine and the Bonsai in hybrid mode
 # and with --show-primitives (splats red, points in their colour; seed Figure 8a) at the three
-# standard views, 400x400, into out/pictures/. Needs ../shared/volumes (skips what is absent).
+# standard views, 400x400, into out/pictures/. Reads volumes/engine.vdb and volumes/bonsai.vdb
+# (made by volumes/fetch.sh; skips what is absent).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/build.sh >/dev/null
 BIN=${BUILD_DIR:-build}/vdbsplat
 OUT=out/pictures
 mkdir -p "$OUT"
-VOLS=../shared/volumes
-declare -A DIMS=([engine]=256,256,128 [bonsai]=256,256,256)
+VOLS=volumes
 declare -A TF=([engine]=ct-bone [bonsai]=ct-bone)
 # The Bonsai stands along +y: frame it from the side, slightly above.
 declare -A VIEW=([engine]="" [bonsai]="--view-dir 1,0.35,0.6 --up 0,1,0")
 # A view where the switch runs through the volume: near voxels splats (red), far ones points.
 declare -A MIXED=([engine]=1.2 [bonsai]=0.7)
 for vol in engine bonsai; do
-  raw=$(ls $VOLS/${vol}_*.raw.gz 2>/dev/null | head -1 || true)
-  if [[ -z "$raw" ]]; then echo "pictures: no $vol volume under $VOLS, skipping" >&2; continue; fi
-  [[ -f $OUT/$vol.vdb ]] || "$BIN" convert "$raw" -o $OUT/$vol.vdb --dims ${DIMS[$vol]} --type uint8 --threshold 0.1176
+  if [[ ! -f $VOLS/$vol.vdb ]]; then
+    echo "pictures: $VOLS/$vol.vdb absent (run volumes/fetch.sh $vol), skipping it" >&2
+    continue
+  fi
   for d in 8 1 0.35; do
-    "$BIN" render $OUT/$vol.vdb -o $OUT/${vol}_d${d}_hybrid.png --tf ${TF[$vol]} ${VIEW[$vol]} --distance $d -v
-    "$BIN" render $OUT/$vol.vdb -o $OUT/${vol}_d${d}_primitives.png --tf ${TF[$vol]} ${VIEW[$vol]} --distance $d --show-primitives
+    "$BIN" render $VOLS/$vol.vdb -o $OUT/${vol}_d${d}_hybrid.png --tf ${TF[$vol]} ${VIEW[$vol]} --distance $d -v
+    "$BIN" render $VOLS/$vol.vdb -o $OUT/${vol}_d${d}_primitives.png --tf ${TF[$vol]} ${VIEW[$vol]} --distance $d --show-primitives
   done
-  "$BIN" render $OUT/$vol.vdb -o $OUT/${vol}_d${MIXED[$vol]}_primitives.png --tf ${TF[$vol]} ${VIEW[$vol]} \
+  "$BIN" render $VOLS/$vol.vdb -o $OUT/${vol}_d${MIXED[$vol]}_primitives.png --tf ${TF[$vol]} ${VIEW[$vol]} \
       --distance ${MIXED[$vol]} --show-primitives -v
 done
 # The README's strip: Engine and Bonsai in hybrid mode, then with --show-primitives where the
