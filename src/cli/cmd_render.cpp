@@ -39,6 +39,7 @@ const char* kHelp =
     "  --lod PX           level of detail: points are merged into aggregates of 2^3, 4^3 or 8^3 voxels\n"
     "                     (same total optical depth, centroid and spread) whose side projects to at\n"
     "                     most PX pixels (default 1; 0 turns it off)\n"
+    "  --simd on|off      splats through the vector loop (default on) or the scalar table path\n"
     "  --footprint P      auto (default): the (i, alpha) reindex table, and the exact ray-centre\n"
     "                     distance for splats far off the axis where the affine index is off;\n"
     "                     table: the reindex table for every splat; exact: closed form per pixel\n"
@@ -69,6 +70,10 @@ RenderSettings settingsFrom(const Args& args) {
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
     if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
+    if (auto v = args.get("--simd")) {
+        if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
+        s.simd = *v == "on";
+    }
     s.showPrimitives = args.has("--show-primitives");
     if (auto v = args.get("--tables")) {
         if (v->empty()) throw Error("--tables: expected a directory, got ''");
@@ -121,7 +126,7 @@ std::string oneLine(const RenderStats& st, const RenderSettings& s) {
 int runRender(const Argv& argv) {
     const Args args(argv,
                     {"-o", "--grid", "--mode", "--size", "--tf", "--eye", "--look-at", "--up", "--view-dir", "--fov", "--distance",
-                     "--threads", "--spp", "--stats", "--threshold", "--lod", "--footprint", "--tables"},
+                     "--threads", "--spp", "--stats", "--threshold", "--lod", "--simd", "--footprint", "--tables"},
                     {"-v", "--show-primitives"});
     if (args.wantsHelp()) {
         std::cout << kHelp;
