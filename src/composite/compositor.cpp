@@ -100,7 +100,8 @@ SkippedPrimitives TileCompositor::composite(std::span<const Primitive> prims, do
 SkippedPrimitives TileCompositor::binToTiles() {
     const size_t tiles = size_t(tilesX_) * tilesY_, n = sortedCount_;
     const size_t chunks = std::clamp<size_t>(n / 16384, 1, 16), per = (n + chunks - 1) / chunks;
-    std::vector<uint32_t> counts(chunks * tiles, 0);
+    std::vector<uint32_t>& counts = binCounts_;  // reused: fresh pages cost a fault each on every window
+    counts.assign(chunks * tiles, 0);
     std::vector<SkippedPrimitives> skippedIn(chunks);
     const auto forTiles = [&](const Primitive& p, auto&& fn) {
         for (int ty = p.range.y0 / kTileSize; ty <= p.range.y1 / kTileSize; ++ty)

@@ -85,6 +85,7 @@ private:
     size_t sortedCount_ = 0;
     std::vector<size_t> binStart_;        // per tile (+1): its list in binEntries_
     std::vector<uint32_t> binEntries_;    // per tile: positions in sorted_, ascending
+    std::vector<uint32_t> binCounts_;     // binToTiles' per-(chunk, tile) counts and cursors
 };
 
 }  // namespace vdbsplat
