@@ -36,6 +36,8 @@ void RenderSettings::validate() const {
     if (threads < 0 || threads > 1024) throw Error("--threads: must be in [0, 1024]");
     if (spp < 1 || spp > 1024) throw Error("--spp: must be in [1, 1024]");
     if (!(std::isfinite(threshold) && threshold > 0.0)) throw Error("--threshold: must be a positive number of pixels");
+    if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
+        throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
     if (!tablesDir.empty()) {
         std::error_code ec;
         if (!std::filesystem::is_directory(tablesDir, ec))
