@@ -187,8 +187,9 @@ TEST_F(CliHostile, TablesThatAreNotRegularFilesAreRefused) {
 TEST_F(CliHostile, ActiveTileVoxelsAreBoundedBeforeWork) {
     auto grid = openvdb::FloatGrid::create(0.0f);
     grid->setName("density");
-    grid->tree().fill(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(1259, 1259, 1259)), 0.5f, true);
-    ASSERT_GT(grid->activeVoxelCount(), 1'990'000'000u);
+    // 10³ tiles of 128³ voxels: 2.1·10⁹ voxels in a file of a few KB.
+    grid->tree().fill(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(1279, 1279, 1279)), 0.5f, true);
+    ASSERT_GT(grid->activeVoxelCount(), 2'000'000'000u);
     openvdb::io::File(path("tiles.vdb")).write({grid});
     const CliResult r = run("render " + q("tiles.vdb") + " -o " + q("o.png") + " --size 32x32", 30);
     expectError(r, "--max-voxels");
