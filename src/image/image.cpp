@@ -1,6 +1,7 @@
 // image/image.cpp — PNG/EXR output through OpenImageIO, atomic via rename (through a
 // symbolic link to its target; never over a device node), and the bounded, checked input
-// of `compare` (one flat 2D image of at most kMaxImageSide² pixels).
+// of `compare` (a PNG or EXR by content, one flat 2D image, bounded in size, checked
+// before any pixel is read).
 #include "image/image.h"
 
 #include <OpenImageIO/imageio.h>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <unistd.h>
 
 #include "util/atomic_file.h"
@@ -72,14 +74,29 @@ std::string oneLineText(std::string s) {
     return s;
 }
 
-/// True when @p path starts with the PNG signature (OpenImageIO picks readers by content too).
-bool looksLikePng(const std::string& path) {
+/// The OpenImageIO reader for @p path chosen by its first bytes: "png", "openexr", or ""
+/// for anything else. compare reads PNG and EXR only: left to itself OpenImageIO tries every
+/// plugin it has (its OpenVDB plugin read a damaged .vdb named .png in-process).
+std::string readerByContent(const std::string& path) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return "";
+    unsigned char sig[8] = {};
+    const size_t n = std::fread(sig, 1, sizeof sig, f);
+    std::fclose(f);
+    if (n == sizeof sig && png_sig_cmp(sig, 0, sizeof sig) == 0) return "png";
+    if (n >= 4 && sig[0] == 0x76 && sig[1] == 0x2f && sig[2] == 0x31 && sig[3] == 0x01) return "openexr";
+    return "";
+}
+
+/// True when @p path starts with OpenVDB's magic number (int64 0x56444220, little-endian).
+bool isVdbFile(const std::string& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) return false;
     unsigned char sig[8] = {};
     const size_t n = std::fread(sig, 1, sizeof sig, f);
     std::fclose(f);
-    return n == sizeof sig && png_sig_cmp(sig, 0, sizeof sig) == 0;
+    static const unsigned char kMagic[8] = {0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0};
+    return n == sizeof sig && std::equal(sig, sig + 8, kMagic);
 }
 
 /// Decodes a PNG once through libpng's simplified API, which reports errors and warnings
@@ -111,7 +128,22 @@ void validatePng(const std::string& path) {
 /// Keeps the codecs under OpenImageIO from printing on their own: their messages must reach
 /// vdbsplat (through geterror() or validatePng) and become the one error line.
 void quietImageLibraries(const std::string& path) {
-    if (looksLikePng(path)) validatePng(path);
+    if (readerByContent(path) == "png") validatePng(path);
+}
+
+/// Opens @p path with the PNG or EXR reader its content calls for; anything else is refused.
+std::unique_ptr<OIIO::ImageInput> openPngOrExr(const std::string& path) {
+    const std::string reader = readerByContent(path);
+    if (reader.empty()) {
+        if (isVdbFile(path)) throw Error(path + ": is a VDB file (a volume image), not a 2D PNG or EXR");
+        throw Error(path + ": not a PNG or EXR image (unrecognised content)");
+    }
+    quietImageLibraries(path);
+    auto in = OIIO::ImageInput::create(reader);
+    OIIO::ImageSpec spec;
+    if (!in || !in->open(path, spec))
+        throw Error(path + ": cannot read image: " + oneLineText(in ? in->geterror() : OIIO::geterror()));
+    return in;
 }
 }  // namespace
 
@@ -162,15 +194,13 @@ void writeImage(const std::string& path, const Image& image, const std::map<std:
 }
 
 Image readImage(const std::string& path) {
-    quietImageLibraries(path);
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(path + ": cannot read image: " + oneLineText(OIIO::geterror()));
+    const std::unique_ptr<OIIO::ImageInput> in = openPngOrExr(path);
     const OIIO::ImageSpec spec = in->spec();
     checkInputSpec(*in, spec, path);
     const int nc = spec.nchannels;
     std::vector<float> data(size_t(spec.width) * spec.height * nc);
     if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data())) throw Error(path + ": cannot decode: " + oneLineText(in->geterror()));
-    const bool srgb = extensionOf(path) != ".exr";
+    const bool srgb = std::string(in->format_name()) != "openexr";  // by content, not by name
     Image image(spec.width, spec.height);
     for (size_t i = 0; i < image.pixels.size(); ++i) {
         glm::vec4 p(0.0f, 0.0f, 0.0f, 1.0f);

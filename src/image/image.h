@@ -40,8 +40,9 @@ void writeImage(const std::string& path, const Image& image,
                 const std::map<std::string, std::string>& metadata = {});
 
 /// @brief Reads a PNG (sRGB, decoded to linear) or EXR (linear) back into an Image.
-/// @throw Error naming the path when it cannot be read, or before reading pixels when it is
-/// not one flat 2D image (a volume, deep or multi-image file) or a side exceeds kMaxImageSide.
+/// The format is chosen by content (PNG or EXR only; OpenImageIO's other readers are never
+/// tried). @throw Error naming the path when it cannot be read, or before reading pixels when
+/// it is not one flat 2D image (a volume, deep or multi-image file) or a side exceeds kMaxImageSide.
 Image readImage(const std::string& path);
 
 /// @brief Checks that @p path has an extension writeImage supports, its folder exists and it

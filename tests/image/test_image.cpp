@@ -54,6 +54,20 @@ TEST(Image, VolumeImageIsRefused) {
     }
 }
 
+// compare reads PNG and EXR only, chosen by content: OpenImageIO's other readers (its
+// OpenVDB plugin among them) are never tried on a file that claims to be an image.
+TEST(Image, OnlyPngAndExrContentIsRead) {
+    test::ScratchDir dir("image");
+    test::spit(dir.path("text.png"), "P3\n1 1\n255\n0 0 0\n");  // a PPM named .png
+    const std::string msg = errorOf([&] { readImage(dir.path("text.png")); });
+    EXPECT_NE(msg.find("not a PNG or EXR"), std::string::npos) << msg;
+    writeImage(dir.path("real.exr"), ramp(2, 2));
+    fs::copy_file(dir.path("real.exr"), dir.path("named.png"));  // an EXR named .png is still read
+    const Image named = readImage(dir.path("named.png"));
+    ASSERT_EQ(named.width, 2);
+    EXPECT_EQ(named.pixels[3], ramp(2, 2).pixels[3]);  // linear, as EXR: not decoded as sRGB
+}
+
 TEST(Image, SidesAboveTheLimitAreRefusedFromTheHeader) {
     test::ScratchDir dir("image");
     // A real (tiny) image passes; the limit is checked on the header's size.
