@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Coverage-guided fuzzing (libFuzzer) of every loader and parser, for SECONDS each
 # (default 60): fuzz_vdb, fuzz_raw, fuzz_transfer_function, fuzz_image, fuzz_tables.
-# Builds them in build-asan/ (scripts/sanitize.sh --build-only), starts from the seeds in
+# Builds them (only them) in build-asan/, as scripts/sanitize.sh configures it, starts from the seeds in
 # tests/fuzz/corpus/<target>/ plus what earlier runs found (build-asan/fuzz/corpus/), and
 # prints executions, coverage and corpus size per target. A crash, leak, timeout or OOM
 # leaves its input in build-asan/fuzz/findings/<target>/ and makes the script fail.
@@ -11,11 +11,13 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-60}
 shift || true
 BUILD_DIR=${ASAN_BUILD_DIR:-build-asan}
-scripts/sanitize.sh --build-only >/dev/null
+scripts/setup.sh
 TARGETS=("$@")
 if [ ${#TARGETS[@]} -eq 0 ]; then
   for f in tests/fuzz/fuzz_*.cpp; do TARGETS+=("$(basename "$f" .cpp)"); done
 fi
+CC=clang CXX=clang++ cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DVDBSPLAT_FUZZ=ON >/dev/null
+cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${TARGETS[@]}" >/dev/null
 export ASAN_OPTIONS=allocator_may_return_null=1:detect_leaks=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$PWD/tests/fuzz/ubsan.supp
 export LSAN_OPTIONS=suppressions=$PWD/tests/fuzz/lsan.supp
