@@ -167,6 +167,7 @@ Options optionsFrom(const Args& args) {
         const std::filesystem::path dir = std::filesystem::path(*o.json).parent_path();
         std::error_code ec;
         if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) throw Error(*o.json + ": folder does not exist");
+        checkOutputPath(*o.json);  // a directory or dangling link fails before the benchmark
     }
     return o;
 }

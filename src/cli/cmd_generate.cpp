@@ -32,7 +32,8 @@ const char* kHelp =
     "\n"
     "options:\n"
     "  -o OUT.vdb      output file (written atomically)\n"
-    "  --res N         grid side in voxels, 2..4096 (and at most 2e9 active voxels); not for cloud\n"
+    "  --res N         grid side in voxels, 2..4096 (sphere: 3..4096; at most 2e9 active voxels);\n"
+    "                  not for cloud\n"
     "  --active N      cloud only: target active voxel count, 1..2000000000\n"
     "  --seed S        cloud only: noise seed, a non-negative integer\n";
 
@@ -58,7 +59,7 @@ int runGenerate(const Argv& argv) {
     }
     const GenerateOptions options = optionsFrom(args);
     const std::string out = args.require("-o");
-    checkOutputDirectory(out);
+    checkRegularOutputPath(out, "-o");
     const auto start = std::chrono::steady_clock::now();
     auto grid = generateVolume(options);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -48,6 +48,8 @@ const char* kHelp =
     "                     a file absent from DIR is built in memory, a corrupt one or one built for\n"
     "                     another kernel is refused (hybrid, splat, point)\n"
     "  --spp N            reference: rays per pixel (default 16, rounded up to a square)\n"
+    "  --max-voxels N     refuse grids with more than N active voxels, active tiles counted voxel\n"
+    "                     by voxel (default 2^30 = 1073741824, at most 2^32)\n"
     "  --threads N        worker threads (default: all cores); the image does not depend on it\n"
     "  --stats FILE.json  write settings, timings and primitive counts as JSON\n"
     "  -v                 print the statistics in one line\n";
@@ -66,6 +68,8 @@ RenderSettings settingsFrom(const Args& args) {
     if (auto v = args.get("--fov")) s.camera.fovDeg = parseDouble(*v, "--fov");
     if (auto v = args.get("--distance")) s.camera.distance = parseDouble(*v, "--distance");
     if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
+    if (auto v = args.get("--max-voxels"))
+        s.maxActiveVoxels = uint64_t(parseInt(*v, "--max-voxels", 1, (long long)kHardMaxActiveVoxels));
     if (auto v = args.get("--spp")) s.spp = int(parseInt(*v, "--spp", 1, 1024));
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
@@ -103,6 +107,7 @@ void checkStatsPath(const std::string& path, const std::string& image) {
     const fs::path folder = fs::path(path).parent_path();
     if (!folder.empty() && !fs::is_directory(folder, ec)) throw Error("--stats: " + path + ": folder does not exist");
     if (fs::is_directory(path, ec)) throw Error("--stats: " + path + ": is a directory");
+    checkOutputPath(path);  // a dangling link or link loop fails before the render
     std::error_code ec1, ec2;
     const fs::path a = fs::weakly_canonical(path, ec1), b = fs::weakly_canonical(image, ec2);
     if (!ec1 && !ec2 && a == b) throw Error("--stats: " + path + ": is the output image (-o)");
@@ -126,7 +131,7 @@ std::string oneLine(const RenderStats& st, const RenderSettings& s) {
 int runRender(const Argv& argv) {
     const Args args(argv,
                     {"-o", "--grid", "--mode", "--size", "--tf", "--eye", "--look-at", "--up", "--view-dir", "--fov", "--distance",
-                     "--threads", "--spp", "--stats", "--threshold", "--lod", "--simd", "--footprint", "--tables"},
+                     "--threads", "--spp", "--stats", "--max-voxels", "--threshold", "--lod", "--simd", "--footprint", "--tables"},
                     {"-v", "--show-primitives"});
     if (args.wantsHelp()) {
         std::cout << kHelp;
@@ -151,6 +156,7 @@ int runRender(const Argv& argv) {
         }
     }();
     const Volume volume = loadVolume(input, settings.gridName);
+    checkVoxelBudget(volume, settings);
     if (auto v = args.get("--eye")) {
         if (auto l = args.get("--look-at")) {
             settings.camera.lookAt = parseVec3(*l, "--look-at");

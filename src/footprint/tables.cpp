@@ -159,13 +159,29 @@ int intervalCount(const ParsedFile& p, double x) {
     return static_cast<int>(x);
 }
 
+/// Largest table file read (the shipped ones are ~16 and ~32 KB): a table directory is
+/// user input, and a link to /dev/zero or a huge file must not be read until memory runs out.
+constexpr std::uintmax_t kMaxTableFileBytes = std::uintmax_t(16) << 20;
+
+/// The whole file, refusing non-regular files (a FIFO would block, a device never end) and
+/// anything larger than kMaxTableFileBytes; reads at most that much even if it grows.
 std::string readFile(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw Error(path.string() + ": not a regular file (table files must be plain files)");
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec) throw Error(path.string() + ": cannot read table file: " + ec.message());
+    if (size > kMaxTableFileBytes)
+        throw Error(path.string() + ": table file is " + std::to_string(size) + " bytes, more than the " +
+                    std::to_string(kMaxTableFileBytes >> 20) + " MiB a table may have");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path.string() + ": cannot open table file");
-    std::ostringstream s;
-    s << in.rdbuf();
+    std::string bytes(size_t(size) + 1, '\0');  // one byte more shows a file that grew meanwhile
+    in.read(bytes.data(), std::streamsize(bytes.size()));
     if (in.bad()) throw Error(path.string() + ": cannot read table file");
-    return s.str();
+    bytes.resize(size_t(in.gcount()));
+    if (bytes.size() > size) throw Error(path.string() + ": table file changed while it was read");
+    return bytes;
 }
 
 /// Temporary file + rename: an interrupted `tables --out` never leaves a torn table.

@@ -5,6 +5,7 @@
 // folder, renamed into place, so a failure never leaves a partial image.
 #pragma once
 #include <glm/glm.hpp>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -22,6 +23,11 @@ struct Image {
     const glm::vec4& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
 };
 
+/// Largest image side readImage accepts (as render's --size): checked before any pixel is read.
+inline constexpr int kMaxImageSide = 16384;
+/// Most pixels readImage accepts (8192², about 2 GB while decoding): checked likewise.
+inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
+
 /// @brief sRGB transfer curve of a linear value in [0, 1] (values outside are clamped).
 float linearToSrgb(float v);
 /// @brief Inverse of linearToSrgb.
@@ -34,10 +40,13 @@ void writeImage(const std::string& path, const Image& image,
                 const std::map<std::string, std::string>& metadata = {});
 
 /// @brief Reads a PNG (sRGB, decoded to linear) or EXR (linear) back into an Image.
-/// @throw Error naming the path when it cannot be read.
+/// The format is chosen by content (PNG or EXR only; OpenImageIO's other readers are never
+/// tried). @throw Error naming the path when it cannot be read, or before reading pixels when
+/// it is not one flat 2D image (a volume, deep or multi-image file) or a side exceeds kMaxImageSide.
 Image readImage(const std::string& path);
 
-/// @brief Checks that @p path has an extension writeImage supports (before any work is done).
+/// @brief Checks that @p path has an extension writeImage supports, its folder exists and it
+/// is not a device node or FIFO (before any work is done).
 /// @throw Error naming the path otherwise.
 void checkImagePath(const std::string& path);
 

@@ -8,6 +8,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <numbers>
 
 #include "footprint/kernel.h"
@@ -56,10 +58,89 @@ double hash01(uint64_t a, uint64_t b, uint64_t c) {
     return double(z >> 11) * (1.0 / 9007199254740992.0);
 }
 
+/// Side of the regions ActiveRegions merges leaves into: a lowest internal node (16 leaves of 8).
+constexpr int kRegionSide = 128;
+
+/// @p x rounded down to an integer and clamped to [lo, hi] (no undefined conversion of a huge double).
+int64_t floorClamped(double x, int64_t lo, int64_t hi) {
+    if (!(x > double(lo))) return lo;  // NaN too
+    if (x >= double(hi)) return hi;
+    return int64_t(std::floor(x));
+}
+
+int64_t ceilClamped(double x, int64_t lo, int64_t hi) {
+    if (!(x > double(lo))) return lo;
+    if (x >= double(hi)) return hi;
+    return int64_t(std::ceil(x));
+}
+
+/// The slices k (along axis m) where the ray's lateral coordinate on axis @p a,
+/// p_a(k) = o_a + (d_a / d_m)(k − o_m), lies in [lo, hi]; false when none.
+bool lateralSlices(double oa, double da, double om, double dm, double lo, double hi, double& k0, double& k1) {
+    if (std::abs(da) < 1e-15) {
+        if (oa < lo || oa > hi) return false;
+        k0 = -std::numeric_limits<double>::infinity();
+        k1 = std::numeric_limits<double>::infinity();
+        return true;
+    }
+    const double slope = da / dm;
+    k0 = om + (lo - oa) / slope;
+    k1 = om + (hi - oa) / slope;
+    if (k0 > k1) std::swap(k0, k1);
+    return true;
+}
+
 }  // namespace
 
-RayIntegrator::RayIntegrator(const Volume& volume, const ClassificationTable& table)
-    : volume_(volume), table_(table), accessor_(volume.grid->getConstAccessor()), bins_(kRingSize) {}
+ActiveRegions::ActiveRegions(const openvdb::FloatGrid& grid) {
+    const auto& tree = grid.tree();
+    std::map<openvdb::Coord, openvdb::CoordBBox> regions;  // keyed by the 128³ region's origin
+    const auto add = [&](const openvdb::CoordBBox& box) {
+        if (box.dim().x() > kRegionSide) {
+            boxes_.push_back(box);  // a large active tile is its own region
+            return;
+        }
+        const openvdb::Coord key(box.min().x() & ~(kRegionSide - 1), box.min().y() & ~(kRegionSide - 1),
+                                 box.min().z() & ~(kRegionSide - 1));
+        auto [it, fresh] = regions.try_emplace(key, box);
+        if (!fresh) it->second.expand(box);
+    };
+    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf)
+        if (leaf->onVoxelCount() > 0) add(leaf->getNodeBoundingBox());
+    auto tile = tree.cbeginValueOn();
+    tile.setMaxDepth(tile.getLeafDepth() - 1);
+    for (; tile; ++tile)
+        if (tile.isTileValue()) add(tile.getBoundingBox());
+    for (const auto& [key, box] : regions) boxes_.push_back(box);
+}
+
+RayIntegrator::RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions)
+    : volume_(volume), table_(table), accessor_(volume.grid->getConstAccessor()), bins_(kRingSize),
+      ownRegions_(regions ? nullptr : std::make_unique<ActiveRegions>(*volume.grid)),
+      regions_(regions ? regions : ownRegions_.get()) {}
+
+std::vector<RayIntegrator::SliceRange>& RayIntegrator::sliceRanges(const glm::dvec3& o, const glm::dvec3& d, int m,
+                                                                  double ea, double eb, int64_t kLo, int64_t kHi) {
+    const int a = (m + 1) % 3, b = (m + 2) % 3;
+    ranges_.clear();
+    for (const openvdb::CoordBBox& box : regions_->boxes()) {
+        double a0, a1, b0, b1;
+        if (!lateralSlices(o[a], d[a], o[m], d[m], box.min()[a] - ea, box.max()[a] + ea, a0, a1)) continue;
+        if (!lateralSlices(o[b], d[b], o[m], d[m], box.min()[b] - eb, box.max()[b] + eb, b0, b1)) continue;
+        // One slice of margin each side: rounding must never drop a slice the full walk would visit.
+        const int64_t first = std::max({int64_t(box.min()[m]), kLo, floorClamped(std::max(a0, b0), kLo, kHi) - 1});
+        const int64_t last = std::min({int64_t(box.max()[m]), kHi, ceilClamped(std::min(a1, b1), kLo, kHi) + 1});
+        if (first <= last) ranges_.push_back({first, last});
+    }
+    std::sort(ranges_.begin(), ranges_.end(), [](const SliceRange& x, const SliceRange& y) { return x.first < y.first; });
+    size_t n = 0;
+    for (const SliceRange& r : ranges_) {
+        if (n > 0 && r.first <= ranges_[n - 1].last + 1) ranges_[n - 1].last = std::max(ranges_[n - 1].last, r.last);
+        else ranges_[n++] = r;
+    }
+    ranges_.resize(n);
+    return ranges_;
+}
 
 bool RayIntegrator::clip(const glm::dvec3& o, const glm::dvec3& d, double& tEnter, double& tExit) const {
     const openvdb::Coord lo = volume_.indexBox.min(), hi = volume_.indexBox.max();
@@ -82,7 +163,9 @@ bool RayIntegrator::clip(const glm::dvec3& o, const glm::dvec3& d, double& tEnte
 /// Visits every active kernel whose support sphere the ray crosses, slice by slice along the
 /// major axis m of d, front to back. visit(tc, rho, value) per kernel; sliceDone(tFrontier)
 /// after each slice with the ray parameter before which no later kernel deposits; it returns
-/// false to stop early.
+/// false to stop early. Slices far from every active region are skipped: one sliceDone call
+/// with the frontier of the last skipped slice stands for theirs (nothing is deposited in
+/// between, and compositing is monotone), so the result is the same as visiting them all.
 template <typename Visit>
 void RayIntegrator::gather(const glm::dvec3& o, const glm::dvec3& d, double tEnter, double tExit, Visit&& visit) {
     const int m = std::abs(d.x) >= std::abs(d.y) ? (std::abs(d.x) >= std::abs(d.z) ? 0 : 2)
@@ -96,34 +179,47 @@ void RayIntegrator::gather(const glm::dvec3& o, const glm::dvec3& d, double tEnt
     const openvdb::Coord lo = volume_.indexBox.min(), hi = volume_.indexBox.max();
     const double m0 = o[m] + dm * tEnter, m1 = o[m] + dm * tExit;
     const int step = dm > 0 ? 1 : -1;
-    int kFirst = int(std::floor(std::min(m0, m1) - kR)), kLast = int(std::ceil(std::max(m0, m1) + kR));
-    kFirst = std::max(kFirst, lo[m]);
-    kLast = std::min(kLast, hi[m]);
-    if (kFirst > kLast) return;
-    if (step < 0) std::swap(kFirst, kLast);
+    // int64 throughout: a box touching INT_MAX must not overflow a loop counter.
+    const int64_t kLo = std::max(floorClamped(std::min(m0, m1) - kR, lo[m], int64_t(hi[m]) + 1), int64_t(lo[m]));
+    const int64_t kHi = std::min(ceilClamped(std::max(m0, m1) + kR, int64_t(lo[m]) - 1, hi[m]), int64_t(hi[m]));
+    if (kLo > kHi) return;
+    const int64_t kLast = step > 0 ? kHi : kLo;
+    const std::vector<SliceRange>& ranges = sliceRanges(o, d, m, ea, eb, kLo, kHi);
+    bool started = false;
+    int64_t previous = 0;
     openvdb::Coord ijk;
-    for (int k = kFirst;; k += step) {
-        const double tk = (k - o[m]) / dm;
-        const glm::dvec3 p = o + d * tk;
-        const int aLo = std::max(int(std::ceil(p[a] - ea)), lo[a]), aHi = std::min(int(std::floor(p[a] + ea)), hi[a]);
-        const int bLo = std::max(int(std::ceil(p[b] - eb)), lo[b]), bHi = std::min(int(std::floor(p[b] + eb)), hi[b]);
-        ijk[m] = k;
-        for (int ia = aLo; ia <= aHi; ++ia) {
-            ijk[a] = ia;
-            for (int ib = bLo; ib <= bHi; ++ib) {
-                ijk[b] = ib;
-                const glm::dvec3 w = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) - o;
-                const double tc = glm::dot(w, d);
-                const double rho2 = glm::dot(w, w) - tc * tc;
-                if (rho2 >= kR * kR) continue;
-                float value;
-                if (!accessor_.probeValue(ijk, value)) continue;
-                visit.kernel(tc, rho2, value);
+    for (size_t r = 0; r < ranges.size(); ++r) {
+        const SliceRange& range = ranges[step > 0 ? r : ranges.size() - 1 - r];
+        const int64_t from = step > 0 ? range.first : range.last, to = step > 0 ? range.last : range.first;
+        for (int64_t k = from;; k += step) {
+            if (started && k != previous + step && !visit.sliceDone((k - o[m]) / dm - reach)) return;
+            started = true;
+            previous = k;
+            const double tk = (k - o[m]) / dm;
+            const glm::dvec3 p = o + d * tk;
+            const int64_t aLo = ceilClamped(p[a] - ea, lo[a], int64_t(hi[a]) + 1);
+            const int64_t aHi = floorClamped(p[a] + ea, int64_t(lo[a]) - 1, hi[a]);
+            const int64_t bLo = ceilClamped(p[b] - eb, lo[b], int64_t(hi[b]) + 1);
+            const int64_t bHi = floorClamped(p[b] + eb, int64_t(lo[b]) - 1, hi[b]);
+            ijk[m] = int(k);
+            for (int64_t ia = aLo; ia <= aHi; ++ia) {
+                ijk[a] = int(ia);
+                for (int64_t ib = bLo; ib <= bHi; ++ib) {
+                    ijk[b] = int(ib);
+                    const glm::dvec3 w = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) - o;
+                    const double tc = glm::dot(w, d);
+                    const double rho2 = glm::dot(w, w) - tc * tc;
+                    if (rho2 >= kR * kR) continue;
+                    float value;
+                    if (!accessor_.probeValue(ijk, value)) continue;
+                    visit.kernel(tc, rho2, value);
+                }
             }
+            if (k == kLast) return;
+            const double tNext = (k + step - o[m]) / dm;
+            if (!visit.sliceDone(tNext - reach)) return;
+            if (k == to) break;
         }
-        if (k == kLast) break;
-        const double tNext = (k + step - o[m]) / dm;
-        if (!visit.sliceDone(tNext - reach)) return;
     }
 }
 
@@ -239,6 +335,7 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
     // Output rows per band, so a band's samples stay under ~128 MiB.
     const int bandRows = std::clamp(int((128.0 * (1 << 20)) / bytesPerRow) - 2 * border, 1, H);
     Image image(W, H);
+    const ActiveRegions regions(*volume.grid);
     std::vector<glm::vec4> samples;
     const double cutoff2 = kPrefilterCutoffSigmas * kPrefilterCutoffSigmas * kPrefilterVariance;
 
@@ -251,7 +348,7 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
             return PixelCoord(px + (sx + hash01(px, py, 2 * s)) / n, py + (sy + hash01(px, py, 2 * s + 1)) / n);
         };
         tbb::parallel_for(tbb::blocked_range<int>(0, sh, 1), [&](const tbb::blocked_range<int>& rows) {
-            RayIntegrator integrator(volume, table);
+            RayIntegrator integrator(volume, table, &regions);
             for (int r = rows.begin(); r < rows.end(); ++r)
                 for (int c = 0; c < sw; ++c)
                     for (int s = 0; s < n * n; ++s) {

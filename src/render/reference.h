@@ -7,7 +7,10 @@
 //
 // Method, per ray (in the grid's index space, where the kernel has radius R):
 //  1. gather every active kernel whose sphere the ray crosses, slice by slice
-//     along the ray's major axis (each voxel is visited once);
+//     along the ray's major axis (each voxel is visited once), visiting only the
+//     slices that pass near an active region (ActiveRegions: boxes from the tree's
+//     leaves and active tiles), so empty space costs nothing — the time follows the
+//     active voxels along the rays, not the bounding box;
 //  2. deposit each kernel's exact line integral (erf, Kernel::segmentIntegral)
 //     into depth bins of kBinLength voxels — optical depth and emission;
 //  3. composite finished bins front to back (α = 1 − exp(−τ)) as the slice
@@ -15,6 +18,7 @@
 // The only approximation is the order of emission inside one bin.
 #pragma once
 #include <glm/glm.hpp>
+#include <memory>
 #include <vector>
 
 #include "camera/camera.h"
@@ -30,11 +34,25 @@ inline constexpr double kBinLength = 0.25;
 /// A ray stops once its transmittance falls below this.
 inline constexpr double kReferenceEpsilon = 1e-4;
 
+/// @brief Index-space boxes that together hold every active voxel of a grid: one per
+/// lowest internal node (128³ voxels) with the union of its leaves and small tiles,
+/// and one per larger active tile. Built once per render (cost follows the leaf count).
+class ActiveRegions {
+public:
+    explicit ActiveRegions(const openvdb::FloatGrid& grid);
+    const std::vector<openvdb::CoordBBox>& boxes() const { return boxes_; }
+
+private:
+    std::vector<openvdb::CoordBBox> boxes_;
+};
+
 /// @brief Integrates single rays through a volume; one per thread (it owns scratch memory
 /// and a tree accessor, never shared across threads).
 class RayIntegrator {
 public:
-    RayIntegrator(const Volume& volume, const ClassificationTable& table);
+    /// @p regions: the volume's ActiveRegions, shared by every integrator of a render; when
+    /// null the integrator builds its own.
+    RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions = nullptr);
     /// @brief Premultiplied RGB and alpha = 1 − T of the ray from world point @p origin
     /// along world direction @p direction (any length), from the origin to infinity.
     glm::dvec4 integrate(const glm::dvec3& origin, const glm::dvec3& direction);
@@ -48,11 +66,20 @@ private:
     template <typename Visit> void gather(const glm::dvec3& oIdx, const glm::dvec3& dIdx, double tEnter, double tExit,
                                           Visit&& visit);
     bool clip(const glm::dvec3& oIdx, const glm::dvec3& dIdx, double& tEnter, double& tExit) const;
+    /// A run of slice indices [first, last] along the major axis.
+    struct SliceRange { int64_t first, last; };
+    /// The slices in [kLo, kHi] along axis m that can hold a kernel the ray reaches (a slice's
+    /// kernel disc has lateral half-extents ea, eb): ascending, disjoint, merged.
+    std::vector<SliceRange>& sliceRanges(const glm::dvec3& o, const glm::dvec3& d, int m, double ea, double eb,
+                                         int64_t kLo, int64_t kHi);
 
     const Volume& volume_;
     const ClassificationTable& table_;
     openvdb::FloatGrid::ConstAccessor accessor_;
     std::vector<Bin> bins_;
+    std::unique_ptr<ActiveRegions> ownRegions_;
+    const ActiveRegions* regions_;
+    std::vector<SliceRange> ranges_;  ///< scratch for sliceRanges
 };
 
 /// @brief Renders the reference image: ⌈√spp⌉² stratified, jittered rays per pixel (a

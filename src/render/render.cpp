@@ -2,6 +2,7 @@
 #include "render/render.h"
 
 #include <chrono>
+#include <cstdio>
 
 #include "footprint/tables.h"
 #include "render/hybrid.h"
@@ -20,14 +21,40 @@ void normalizationRange(const Volume& volume, float& lo, float& hi) {
     }
 }
 
+void checkVoxelBudget(const Volume& volume, const RenderSettings& settings) {
+    if (volume.activeVoxels <= settings.maxActiveVoxels) return;
+    throw Error(volume.file + ": grid '" + volume.name + "' has " + std::to_string(volume.activeVoxels) +
+                " active voxels (active tiles counted voxel by voxel), more than the limit of " +
+                std::to_string(settings.maxActiveVoxels) + " (raise it with --max-voxels, at most " +
+                std::to_string(kHardMaxActiveVoxels) + ")");
+}
+
+/// Refuses an --eye so far from the grid that it covers less than a pixel and the depth
+/// arithmetic of the renderers loses precision (10^6 bounding-box diagonals).
+void checkEyeDistance(const CameraSpec& spec, const glm::dvec3& lo, const glm::dvec3& hi) {
+    if (!spec.hasEye) return;
+    const double diagonal = glm::length(hi - lo);
+    const glm::dvec3 nearest = glm::clamp(spec.eye, lo, hi);
+    const double distance = glm::length(spec.eye - nearest);
+    const double limit = kMaxEyeDistanceInDiagonals * diagonal;
+    if (!(distance <= limit)) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "--eye: %.6g from the grid's bounds, more than %.0e times their diagonal (%.6g)",
+                      distance, kMaxEyeDistanceInDiagonals, diagonal);
+        throw Error(buf);
+    }
+}
+
 Camera cameraFor(const Volume& volume, const RenderSettings& settings) {
     glm::dvec3 lo, hi;
     volume.worldBounds(lo, hi);
+    checkEyeDistance(settings.camera, lo, hi);
     return makeCamera(settings.camera, lo, hi);
 }
 
 Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings, RenderStats& stats) {
     const auto start = std::chrono::steady_clock::now();
+    checkVoxelBudget(volume, settings);
     float lo, hi;
     normalizationRange(volume, lo, hi);
     const ClassificationTable table = tf.bake(lo, hi, volume.voxelSize);

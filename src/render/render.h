@@ -16,7 +16,13 @@ namespace vdbsplat {
 /// [0, 1] when every finite active value lies in it, else the grid's [min, max].
 void normalizationRange(const Volume& volume, float& lo, float& hi);
 
+/// @brief Refuses a grid with more active voxels than settings.maxActiveVoxels (before any work).
+/// @throw Error naming the file, the count, the limit and --max-voxels.
+void checkVoxelBudget(const Volume& volume, const RenderSettings& settings);
+
 /// @brief The camera @p settings describe for @p volume (framing its world bounds by default).
+/// @throw Error "--eye: …" when the eye is more than kMaxEyeDistanceInDiagonals bounding-box
+/// diagonals from the grid.
 Camera cameraFor(const Volume& volume, const RenderSettings& settings);
 
 /// @brief Renders @p volume with @p settings (already validated) and transfer function @p tf.

@@ -38,6 +38,8 @@ void RenderSettings::validate() const {
     if (!(std::isfinite(threshold) && threshold > 0.0)) throw Error("--threshold: must be a positive number of pixels");
     if (!(std::isfinite(lodPx) && lodPx >= 0.0 && lodPx <= 64.0))
         throw Error("--lod: must be a number of pixels in [0, 64] (0 turns level of detail off)");
+    if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
+        throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
     if (!tablesDir.empty()) {
         std::error_code ec;
         if (!std::filesystem::is_directory(tablesDir, ec))

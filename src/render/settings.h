@@ -28,6 +28,15 @@ std::string toString(FootprintPath path);
 RenderMode parseRenderMode(const std::string& name);
 std::string toString(RenderMode mode);
 
+/// Default bound on the active voxels (tiles counted voxel by voxel) a render accepts: a
+/// few KB of active tiles can hold billions of voxels, hours of work. --max-voxels raises it.
+inline constexpr uint64_t kDefaultMaxActiveVoxels = uint64_t(1) << 30;
+/// The streaming limit --max-voxels cannot exceed.
+inline constexpr uint64_t kHardMaxActiveVoxels = uint64_t(1) << 32;
+/// An --eye farther from the grid than this many bounding-box diagonals is refused (it would
+/// see the grid as less than a pixel, and the depth arithmetic would lose precision).
+inline constexpr double kMaxEyeDistanceInDiagonals = 1e6;
+
 struct RenderSettings {
     RenderMode mode = RenderMode::Hybrid;
     CameraSpec camera;
@@ -46,6 +55,7 @@ struct RenderSettings {
     bool simd = true;
     std::string tablesDir;                  ///< footprint/reindex tables; empty: defaultTablesDir()
     StreamOptions stream;                   ///< how the grid is streamed: speed and memory, never the image
+    uint64_t maxActiveVoxels = kDefaultMaxActiveVoxels;  ///< larger grids are refused before any work
 
     /// @throw Error naming the flag of the first invalid value (--tables: DIR must be a directory).
     void validate() const;

@@ -2,7 +2,8 @@
 // Owns: a description of every grid of a .vdb file — name, value type, class, active
 // voxel count, index and world bounding boxes, voxel size, the index→world matrix,
 // and the value range of float/double grids. Works for any grid type the library
-// registers (vector, int, bool, points…) and for empty grids; never renders.
+// registers (vector, int, bool, points…) and for empty grids; never renders. Everything
+// taken from the file is escaped (printable) before it reaches the terminal.
 #include <openvdb/io/File.h>
 
 #include <cmath>
@@ -18,6 +19,35 @@
 namespace vdbsplat {
 
 namespace {
+
+/// Text from the file, safe to print on a terminal: control characters (C0, DEL, and the
+/// C1 range U+0080–U+009F, which includes CSI) and bytes that are not valid UTF-8 are
+/// written as \xHH, so a grid name cannot send escape sequences or break the line layout.
+std::string printable(const std::string& text) {
+    static const char* hex = "0123456789abcdef";
+    std::string out;
+    const auto escape = [&](unsigned char u) { out += std::string("\\x") + hex[u >> 4] + hex[u & 15]; };
+    for (size_t i = 0; i < text.size();) {
+        const auto u = static_cast<unsigned char>(text[i]);
+        if (u < 0x80) {
+            if (u < 0x20 || u == 0x7f || u == '\\') escape(u); else out += char(u);
+            ++i;
+            continue;
+        }
+        const int n = u >= 0xf0 && u < 0xf5 ? 4 : u >= 0xe0 ? 3 : u >= 0xc2 && u < 0xe0 ? 2 : 0;
+        bool valid = n > 0 && i + n <= text.size();
+        for (int k = 1; valid && k < n; ++k) valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+        if (valid && n == 2 && u == 0xc2 && static_cast<unsigned char>(text[i + 1]) < 0xa0) valid = false;  // C1
+        if (!valid) {
+            escape(u);
+            ++i;
+            continue;
+        }
+        out.append(text, i, size_t(n));
+        i += size_t(n);
+    }
+    return out;
+}
 
 std::string vec3(const openvdb::Vec3d& v) {
     std::ostringstream s;
@@ -44,7 +74,7 @@ std::string worldBox(const openvdb::math::Transform& xform, const openvdb::Coord
 }
 
 std::string matrixText(const openvdb::math::Transform& xform) {
-    if (!xform.isLinear()) return "    (" + xform.mapType() + ": not linear, no matrix)\n";
+    if (!xform.isLinear()) return "    (" + printable(xform.mapType()) + ": not linear, no matrix)\n";
     const openvdb::Mat4d m = xform.baseMap()->getAffineMap()->getMat4();
     std::ostringstream s;
     s << std::setprecision(9);
@@ -77,9 +107,9 @@ std::string describeGrid(const openvdb::GridBase& grid, size_t index) {
     std::ostringstream s;
     const auto& xform = grid.transform();
     const uint64_t active = grid.activeVoxelCount();
-    s << "grid " << index << ": '" << grid.getName() << "'\n";
-    s << "  value type:    " << grid.valueType() << "\n";
-    s << "  class:         " << openvdb::GridBase::gridClassToString(grid.getGridClass()) << "\n";
+    s << "grid " << index << ": '" << printable(grid.getName()) << "'\n";
+    s << "  value type:    " << printable(grid.valueType()) << "\n";
+    s << "  class:         " << printable(openvdb::GridBase::gridClassToString(grid.getGridClass())) << "\n";
     s << "  active voxels: " << active << "\n";
     if (active == 0) {
         s << "  index bbox:    empty\n  world bbox:    empty\n";
@@ -90,7 +120,7 @@ std::string describeGrid(const openvdb::GridBase& grid, size_t index) {
         s << "  world bbox:    " << worldBox(xform, box) << " (voxel extents)\n";
     }
     s << "  voxel size:    " << vec3(xform.voxelSize()) << "\n";
-    s << "  transform:     " << xform.mapType() << ", index -> world (row vector times matrix):\n" << matrixText(xform);
+    s << "  transform:     " << printable(xform.mapType()) << ", index -> world (row vector times matrix):\n" << matrixText(xform);
     s << valueRange<openvdb::FloatGrid>(grid) << valueRange<openvdb::DoubleGrid>(grid);
     return s.str();
 }
@@ -120,7 +150,7 @@ std::string describeFile(const std::string& path) {
     const openvdb::GridPtrVecPtr grids = readAllGrids(path, version);
     log.keep();
     std::ostringstream s;
-    s << path << ": VDB file version " << version << ", " << grids->size() << " grid" << (grids->size() == 1 ? "" : "s")
+    s << printable(path) << ": VDB file version " << printable(version) << ", " << grids->size() << " grid" << (grids->size() == 1 ? "" : "s")
       << "\n";
     for (size_t i = 0; i < grids->size(); ++i) s << describeGrid(*(*grids)[i], i);
     return s.str();

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <unistd.h>
 
+#include "util/atomic_file.h"
 #include "util/error.h"
 #include "volume/vdb_check.h"
 
@@ -147,16 +148,29 @@ Volume loadVolume(const std::string& path, const std::string& gridName) {
 
 void writeVolume(const std::string& path, openvdb::FloatGrid::Ptr grid) {
     initOpenVdb();
-    const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+    checkRegularOutputPath(path);
+    const std::string target = resolveOutputPath(path);  // through a symbolic link, never replacing it
+    const std::string tmp = temporaryPathFor(target);
     try {
         openvdb::io::File file(tmp);
         file.write({grid});
         file.close();
-        std::filesystem::rename(tmp, path);
     } catch (const std::exception& e) {
         std::remove(tmp.c_str());
-        throw Error(path + ": cannot write VDB file (" + std::string(e.what()) + ")");
+        std::string what = e.what();  // OpenVDB names the temporary file: name the output instead
+        for (size_t at = what.find(tmp); at != std::string::npos; at = what.find(tmp, at + path.size()))
+            what.replace(at, tmp.size(), path);
+        throw Error(path + ": cannot write VDB file (" + what + ")");
     }
+    // OpenVDB does not check its stream: a full disk leaves a truncated file and no error.
+    // The structural pre-check finds a grid that ends past the end of the file.
+    try {
+        checkVdbStructure(tmp);
+    } catch (const Error&) {
+        std::remove(tmp.c_str());
+        throw Error(path + ": cannot write VDB file (the written file is incomplete: disk full or file too large?)");
+    }
+    renameIntoPlace(tmp, target, path);
 }
 
 }  // namespace vdbsplat

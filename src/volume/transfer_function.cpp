@@ -54,6 +54,43 @@ double jsonNumber(float v) {
 
 std::string fail(const std::string& origin, const std::string& what) { return origin + ": " + what; }
 
+/// Deepest array/object nesting a transfer-function file may use (the formats need 3).
+constexpr int kMaxJsonDepth = 64;
+
+/// A short text of @p v for a message: scalars and small containers as JSON, cut to
+/// @p maxLength; a large container only by its size (never dumps unbounded JSON).
+std::string preview(const nlohmann::json& v, size_t maxLength) {
+    if (v.is_structured() && v.size() > 16)
+        return std::string(v.is_array() ? "an array" : "an object") + " of " + std::to_string(v.size()) + " elements";
+    return oneLine(v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), maxLength);
+}
+
+std::string positionOf(const std::string& text, size_t byte);
+
+/// Refuses JSON nested deeper than kMaxJsonDepth before it is parsed (a file of 100 000
+/// '[' would otherwise exhaust the stack in the parser or in dump()). Strings are skipped,
+/// so brackets inside them do not count.
+void checkNesting(const std::string& text, const std::string& origin) {
+    int depth = 0;
+    bool inString = false, escaped = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (escaped) escaped = false;
+            else if (c == '\\') escaped = true;
+            else if (c == '"') inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth)
+                throw Error(fail(origin, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels at " +
+                                             positionOf(text, i + 1) + " (transfer functions need 3)"));
+        } else if (c == ']' || c == '}') {
+            depth = std::max(0, depth - 1);
+        }
+    }
+}
+
 // --- Piecewise-linear evaluation --------------------------------------------
 
 /// Evaluates points {x, value} (x non-decreasing) at @p x: linear between points,
@@ -109,7 +146,7 @@ void validateExtinction(const std::vector<TransferFunction::ExtinctionPoint>& po
 
 /// A finite JSON number that fits a float; @p where names it in the error.
 float number(const json& v, const std::string& where, const std::string& origin) {
-    if (!v.is_number()) throw Error(fail(origin, where + ": expected a number, got " + oneLine(v.dump(), 40)));
+    if (!v.is_number()) throw Error(fail(origin, where + ": expected a number, got " + preview(v, 40)));
     const double d = v.get<double>();
     if (!std::isfinite(d) || std::abs(d) > double(std::numeric_limits<float>::max()))
         throw Error(fail(origin, where + ": number is not finite or out of range"));
@@ -128,7 +165,7 @@ std::vector<std::vector<float>> tuples(const json& obj, const std::string& key, 
     for (size_t i = 0; i < list.size(); ++i) {
         const std::string where = key + "[" + std::to_string(i) + "]";
         if (!list[i].is_array() || list[i].size() != size)
-            throw Error(fail(origin, where + ": expected " + shape + ", got " + oneLine(list[i].dump(), 60)));
+            throw Error(fail(origin, where + ": expected " + shape + ", got " + preview(list[i], 60)));
         std::vector<float> t(size);
         for (size_t k = 0; k < size; ++k) t[k] = number(list[i][k], where, origin);
         out.push_back(std::move(t));
@@ -275,6 +312,7 @@ std::string parseReason(const std::string& what) {
 }
 
 json parseJsonText(const std::string& text, const std::string& origin) {
+    checkNesting(text, origin);
     try {
         return json::parse(text);
     } catch (const json::parse_error& e) {

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <random>
 #include <sstream>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "footprint/kernel.h"
@@ -195,6 +196,25 @@ TEST(Tables, AbsentFilesAreBuiltInMemoryMissingDirRefusedByLoad) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find(kFootprintTableFile), std::string::npos) << e.what();
     }
+}
+
+// A FIFO hung the read; a link to /dev/zero read until memory ran out (issue 12).
+TEST(Tables, NonRegularAndHugeFilesAreRefusedWithoutReading) {
+    const fs::path dir = copyShipped("special");
+    fs::remove(dir / kFootprintTableFile);
+    ASSERT_EQ(::mkfifo((dir / kFootprintTableFile).c_str(), 0644), 0);
+    expectRefused(dir, kFootprintTableFile, "not a regular file");
+    fs::remove(dir / kFootprintTableFile);
+    fs::create_symlink("/dev/zero", dir / kFootprintTableFile);
+    expectRefused(dir, kFootprintTableFile, "not a regular file");
+    fs::remove(dir / kFootprintTableFile);
+    {
+        std::ofstream big(dir / kFootprintTableFile, std::ios::binary);
+        big.seekp((std::streamoff(17) << 20) - 1);  // sparse: 17 MiB
+        big.put('\0');
+    }
+    expectRefused(dir, kFootprintTableFile, "MiB");
+    fs::remove_all(dir);
 }
 
 TEST(Tables, Fnv1a64KnownVectors) {

@@ -67,6 +67,43 @@ TEST(Reference, IsolatedKernelDepositsItsLineIntegral) {
     EXPECT_NEAR(integrator.opticalDepth(centre + dir * 3.0, dir), 0.0, 1e-12);
 }
 
+// Skipping empty space changes the work, never a ray: with regions that cover the whole
+// bounding box (the full walk of every slice, as before issue 12) every ray of a sparse grid
+// of far-apart clusters integrates to bit-identical colour, alpha and optical depth.
+TEST(Reference, EmptySpaceSkippingLeavesEveryRayBitIdentical) {
+    initOpenVdb();
+    auto grid = openvdb::FloatGrid::create(0.f);
+    grid->setName("density");
+    uint32_t h = 12345;
+    const openvdb::Coord centres[] = {{0, 0, 0}, {300, 40, -20}, {-150, 260, 90}, {140, 130, 40}};
+    for (const openvdb::Coord& c : centres)
+        for (int i = 0; i < 400; ++i) {
+            h = h * 1664525u + 1013904223u;
+            grid->tree().setValueOn(c + openvdb::Coord(int(h >> 8) % 9, int(h >> 16) % 9, int(h >> 24) % 9),
+                                    float((h >> 4) % 100) / 100.f);
+        }
+    const Volume volume = makeVolume(grid, "clusters");
+    auto cover = openvdb::FloatGrid::create(0.f);
+    cover->tree().fill(volume.indexBox, 1.f, true);
+    const ActiveRegions everything(*cover);
+    const ClassificationTable table = test::rampTable(0.6f);
+    RayIntegrator skipping(volume, table), full(volume, table, &everything);
+    const glm::dvec3 eye(-400.0, -300.0, 250.0);
+    int hits = 0;
+    for (int i = 0; i < 400; ++i) {
+        h = h * 1664525u + 1013904223u;
+        const openvdb::Coord& c = centres[i % 4];
+        const glm::dvec3 target(c.x() + 4.0 + (h % 1000) / 100.0 - 5.0, c.y() + 4.0 + ((h >> 10) % 1000) / 100.0 - 5.0,
+                                c.z() + 4.0);
+        const glm::dvec3 dir = target - eye;
+        const glm::dvec4 a = skipping.integrate(eye, dir), b = full.integrate(eye, dir);
+        EXPECT_EQ(a, b) << "ray " << i;
+        EXPECT_EQ(skipping.opticalDepth(eye, dir), full.opticalDepth(eye, dir)) << "ray " << i;
+        hits += a.w > 0.0;
+    }
+    EXPECT_GT(hits, 200);  // the rays do cross the clusters
+}
+
 RenderSettings smallSettings(int width, int height) {
     RenderSettings s;
     s.mode = RenderMode::Reference;

@@ -64,11 +64,15 @@ struct CliResult {
 };
 
 /// @brief Runs `vdbsplat ARGS` through the shell (ARGS quoted by the caller); stdout and
-/// stderr go through files in @p logDir.
-inline CliResult runVdbsplat(const std::string& args, const fs::path& logDir) {
+/// stderr go through files in @p logDir. @p timeoutSeconds > 0 kills it after that long
+/// (rc 124: a bound on time, never a timed assertion); @p shellPrefix runs first in the
+/// same shell (e.g. "ulimit -f 8; ").
+inline CliResult runVdbsplat(const std::string& args, const fs::path& logDir, int timeoutSeconds = 0,
+                             const std::string& shellPrefix = "") {
     const fs::path out = logDir / "stdout.txt", err = logDir / "stderr.txt";
-    const std::string cmd =
-        std::string("'") + VDBSPLAT_BINARY + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+    const std::string timeout = timeoutSeconds > 0 ? "timeout -k 5 " + std::to_string(timeoutSeconds) + " " : "";
+    const std::string cmd = shellPrefix + timeout + "'" + VDBSPLAT_BINARY + "' " + args + " >'" + out.string() +
+                            "' 2>'" + err.string() + "'";
     const int status = std::system(cmd.c_str());
     CliResult r;
     r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

@@ -176,6 +176,41 @@ TEST_F(Raw, TruncatedOrCorruptGzipIsAnError) {
     EXPECT_NE(errorOf([&] { convertRaw(bad, spec(64, 64, 8, RawType::UInt8)); }).find(bad), std::string::npos);
 }
 
+// zlib's gzread stopped quietly at bytes that are not another gzip member (issue 12).
+TEST_F(Raw, TrailingGarbageAfterGzipIsRefusedConcatenatedMembersAreRead) {
+    const Bytes data = pattern8(16 * 16 * 4);
+    const std::string gz = writeGz("t.raw.gz", data);
+    std::ifstream in(gz, std::ios::binary);
+    const Bytes member((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    Bytes tail = member;
+    for (const char c : std::string("garbage")) tail.push_back(static_cast<unsigned char>(c));
+    const std::string bad = writePlain("tail.raw.gz", tail);
+    const std::string msg = errorOf([&] { convertRaw(bad, spec(16, 16, 4, RawType::UInt8)); });
+    EXPECT_NE(msg.find("trailing garbage"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(bad), std::string::npos) << msg;
+    // Two members of half the data each (what `cat a.gz b.gz` makes) read as one stream.
+    const std::string first = writeGz("a.gz", Bytes(data.begin(), data.begin() + data.size() / 2));
+    const std::string second = writeGz("b.gz", Bytes(data.begin() + data.size() / 2, data.end()));
+    std::ifstream ia(first, std::ios::binary), ib(second, std::ios::binary);
+    Bytes both((std::istreambuf_iterator<char>(ia)), std::istreambuf_iterator<char>());
+    both.insert(both.end(), std::istreambuf_iterator<char>(ib), std::istreambuf_iterator<char>());
+    const auto joined = convertRaw(writePlain("both.raw.gz", both), spec(16, 16, 4, RawType::UInt8));
+    const auto plain = convertRaw(writePlain("p.raw", data), spec(16, 16, 4, RawType::UInt8));
+    EXPECT_EQ(joined->activeVoxelCount(), plain->activeVoxelCount());
+    EXPECT_EQ(joined->tree().getValue(Coord(15, 15, 3)), plain->tree().getValue(Coord(15, 15, 3)));
+}
+
+// 130 KB of gzip'd 0xFF became 1.3·10⁸ active voxels: X*Y*Z is bounded before reading.
+TEST_F(Raw, VoxelCountIsBoundedBeforeReading) {
+    const std::string path = writePlain("small.raw", pattern8(8));
+    RawSpec big = spec(512, 512, 512, RawType::UInt8);
+    const std::string msg = errorOf([&] { convertRaw(path, big); });
+    EXPECT_NE(msg.find("--dims"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("--max-voxels"), std::string::npos) << msg;
+    big.maxVoxels = kHardMaxRawVoxels;  // raised: now the size check speaks
+    EXPECT_NE(errorOf([&] { convertRaw(path, big); }).find("size mismatch"), std::string::npos);
+}
+
 TEST_F(Raw, MissingFileAndDirectory) {
     EXPECT_NE(errorOf([&] { convertRaw(dir_ + "/nope.raw", spec(1, 1, 1, RawType::UInt8)); }).find("no such file"),
               std::string::npos);
@@ -206,6 +241,14 @@ TEST(RawParse, DimsTypeAndSpacing) {
     EXPECT_THROW(parseUniformSpacing("1,1,0", "--spacing"), Error);
     EXPECT_THROW(parseUniformSpacing("-1,-1,-1", "--spacing"), Error);
     EXPECT_THROW(parseUniformSpacing("1,1", "--spacing"), Error);
+    // 1e-7 gave OpenVDB's "Non-zero scale values required"; 1e300 failed later at --eye.
+    for (const char* bad : {"1e-7,1e-7,1e-7", "1e300,1e300,1e300", "5e-5,5e-5,5e-5", "2e6,2e6,2e6"}) {
+        const std::string msg = errorOf([&] { parseUniformSpacing(bad, "--spacing"); });
+        EXPECT_NE(msg.find("--spacing"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("outside"), std::string::npos) << msg;
+    }
+    EXPECT_EQ(parseUniformSpacing("1e-4,1e-4,1e-4", "--spacing"), 1e-4);
+    EXPECT_EQ(parseUniformSpacing("1e6,1e6,1e6", "--spacing"), 1e6);
 }
 
 /// Converts a shared volume, or skips the test when it is absent.

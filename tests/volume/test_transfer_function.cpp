@@ -366,6 +366,37 @@ TEST(TransferFunctionInvalid, HugeFileIsRefusedBeforeParsing) {
     EXPECT_NE(msg.find("limited to 16 MiB"), std::string::npos) << msg;
 }
 
+// 30 000–100 000 levels of nesting overflowed the stack (json::dump in the message; issue 12).
+TEST(TransferFunctionInvalid, DeepNestingIsRefusedBeforeParsing) {
+    const std::string deep(100000, '['), close(100000, ']');
+    const std::string texts[] = {
+        deep + close,                                             // bare arrays
+        "{\"color\": " + deep + close + "}",                       // inside the vdbsplat form
+        "{\"RGBPoints\": " + deep + "0" + close + "}",             // ParaView form, a number inside
+        "[" + std::string(100000, '{') + std::string(100000, '}') + "]",  // objects (invalid, but deep first)
+    };
+    for (const std::string& text : texts) {
+        const std::string msg = errorOf([&] { TransferFunction::fromJson(text, "deep.json"); });
+        EXPECT_NE(msg.find("deep.json"), std::string::npos) << msg.substr(0, 200);
+        EXPECT_NE(msg.find("nested deeper than"), std::string::npos) << msg.substr(0, 200);
+        EXPECT_LT(msg.size(), 200u);
+    }
+    // Brackets inside strings do not count; ordinary files are three levels deep.
+    const std::string name = "{\"name\": \"" + deep + "\", \"color\": [[0, 1, 1, 1]], \"extinction\": [[0, 1]]}";
+    EXPECT_EQ(TransferFunction::fromJson(name, "n.json").name(), deep);
+}
+
+// A wrong element that is a large array is described by its size, not dumped into the message.
+TEST(TransferFunctionInvalid, MessagesNeverDumpLargeValues) {
+    std::string big = "[";
+    for (int i = 0; i < 100000; ++i) big += (i ? ",1" : "1");
+    big += "]";
+    const std::string msg = errorOf(
+        [&] { TransferFunction::fromJson("{\"color\": [" + big + "], \"extinction\": [[0, 1]]}", "big.json"); });
+    EXPECT_NE(msg.find("an array of 100000 elements"), std::string::npos) << msg.substr(0, 300);
+    EXPECT_LT(msg.size(), 300u);
+}
+
 TEST(TransferFunctionInvalid, FolderIsNotAFile) {
     TempDir dir;
     const std::string msg = errorOf([&] { TransferFunction::fromSpec(dir.path()); });
