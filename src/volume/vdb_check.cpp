@@ -101,17 +101,6 @@ void skipMetadata(Reader& r, uint64_t end) {
     }
 }
 
-/// Bytes of a map's data after its type name (math/Maps.cc: ScaleMap reads five Vec3d,
-/// ScaleTranslateMap six, TranslationMap one, AffineMap and UnitaryMap a Mat4d); 0 for
-/// others (a frustum map: variable), which end the check there.
-uint64_t mapBytes(const std::string& type) {
-    if (type == "UniformScaleMap" || type == "ScaleMap") return 5 * 24;
-    if (type == "UniformScaleTranslateMap" || type == "ScaleTranslateMap") return 6 * 24;
-    if (type == "TranslationMap") return 24;
-    if (type == "AffineMap" || type == "UnitaryMap") return 128;
-    return 0;
-}
-
 /// Bytes of a tree's value type from the grid type ("Tree_float_5_4_3"); 0 when unknown.
 uint64_t valueBytes(const std::string& gridType) {
     static const std::pair<const char*, uint64_t> kTypes[] = {
@@ -132,7 +121,7 @@ void checkGridHeader(Reader& r, uint32_t version, const std::string& gridType, u
     if (version >= kGridCompressionVersion) r.value<uint32_t>("grid compression flags");
     skipMetadata(r, blockPos);
     if (version >= kInstancingVersion) {  // older files put the topology first
-        const uint64_t map = mapBytes(r.string("grid transform type"));
+        const uint64_t map = vdbMapBytes(r.string("grid transform type"));
         const uint64_t value = valueBytes(gridType);
         if (map > 0 && value > 0) {
             r.skip(map, "grid transform");
@@ -164,6 +153,16 @@ void checkGridDescriptors(Reader& r, uint32_t version) {
 }
 
 }  // namespace
+
+// math/Maps.cc: ScaleMap reads five Vec3d, ScaleTranslateMap six, TranslationMap one,
+// AffineMap and UnitaryMap a Mat4d.
+uint64_t vdbMapBytes(const std::string& type) {
+    if (type == "UniformScaleMap" || type == "ScaleMap") return 5 * 24;
+    if (type == "UniformScaleTranslateMap" || type == "ScaleTranslateMap") return 6 * 24;
+    if (type == "TranslationMap") return 24;
+    if (type == "AffineMap" || type == "UnitaryMap") return 128;
+    return 0;
+}
 
 void checkVdbStructure(const std::string& path) {
     std::error_code ec;

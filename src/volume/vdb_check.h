@@ -23,6 +23,10 @@ namespace vdbsplat {
 /// @throw Error "<path>: not a VDB file …" or "<path>: truncated or corrupt VDB file (…)".
 void checkVdbStructure(const std::string& path);
 
+/// @brief Bytes of a linear map's data after its type name in OpenVDB's stream layout
+/// (Transform::write: type name, then the map); 0 for other maps (a frustum: variable).
+uint64_t vdbMapBytes(const std::string& mapType);
+
 /// @brief Checks that @p path exists and is a regular file, runs checkVdbStructure, then
 /// opens @p file without delayed loading (so a truncated file fails here, not mid-render).
 /// @throw Error naming @p path: no such file, not a regular file, not a VDB, truncated.
@@ -45,6 +49,8 @@ public:
     OpenVdbLogCapture(const OpenVdbLogCapture&) = delete;
     OpenVdbLogCapture& operator=(const OpenVdbLogCapture&) = delete;
     void keep();
+    /// @brief What was held back so far.
+    std::string held() const { return held_.str(); }
 
 private:
     std::ostringstream held_;
