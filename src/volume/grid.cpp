@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <optional>
 #include <iostream>
 #include <mutex>
 #include <unistd.h>
@@ -19,8 +21,21 @@ namespace {
 
 bool isScalarType(const std::string& type) { return type == "float" || type == "double"; }
 
+/// The leaves a grid of @p meta's value type held when written (from the stats metadata that
+/// io::File::write adds: file_mem_bytes); 0 when unknown.
+uint64_t estimatedLeaves(const openvdb::GridBase& meta) {
+    const auto bytes = meta.getMetadata<openvdb::Int64Metadata>("file_mem_bytes");
+    if (!bytes || bytes->value() <= 0) return 0;
+    const uint64_t perLeaf = meta.valueType() == "double"
+                                 ? sizeof(openvdb::DoubleTree::LeafNodeType) + 512 * sizeof(double)
+                                 : sizeof(openvdb::FloatTree::LeafNodeType) + 512 * sizeof(float);
+    return uint64_t(bytes->value()) / perLeaf;
+}
+
 /// Opens @p path and reads the grid to render: @p gridName, or the first float or double grid.
-openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::string& gridName) {
+/// @p hint, if given, gets the grid's estimated leaf count before its values are read.
+openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::string& gridName,
+                                        const std::function<void(uint64_t)>& hint = {}) {
     openvdb::io::File file(path);
     openVdbFile(file, path);
     openvdb::GridBase::Ptr base;
@@ -33,6 +48,7 @@ openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::stri
                     throw Error(path + ": grid '" + gridName + "' holds " + meta->valueType() +
                                 " values; only float and double grids can be rendered");
                 chosen = meta->getName();
+                if (hint) hint(estimatedLeaves(*meta));
                 break;
             }
         }
@@ -141,19 +157,28 @@ Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label) {
 
 // The grid is read once, in a forked child (OpenVDB's reader can crash on damaged data:
 // there that is a one-line Error here), which hands it over as a float tree through a
-// memfd (volume/grid_transfer.h); the parent rebuilds it, checking every byte, and
-// sanitizes its values as it goes. OpenVDB's log lines are captured in the child and
+// memfd (volume/grid_transfer.h); the parent allocates the leaves meanwhile, then rebuilds
+// the tree, checking every byte, and sanitizes its values as it goes. OpenVDB's log lines are captured in the child and
 // written here only when the read succeeded, as before; this process's stderr is never redirected.
 Volume loadVolume(const std::string& path, const std::string& gridName) {
     initOpenVdb();
     TransferMemory transfer(path);
-    readInChildProcess(path, [&] {
+    ChildRead child(path, [&](const std::function<void(uint64_t)>& hint) {
         OpenVdbLogCapture log;
-        const openvdb::GridBase::Ptr base = readGridToRender(path, gridName);
+        const openvdb::GridBase::Ptr base = readGridToRender(path, gridName, hint);
         double voxelSize = 0.0;  // refuse what the parent would refuse, before handing it over
         linearUniformMap(base->transform(), gridLabel(path, base->getName()), voxelSize);
         encodeGridTransfer(*base, log.held(), transfer.fd(), path);
     });
+    // While the child reads, allocate the leaves it estimates (their page faults are most of
+    // what building a tree costs), at most one per 64 bytes of file: each leaf's value mask
+    // is stored there uncompressed.
+    if (const std::optional<uint64_t> leaves = child.hint()) {
+        std::error_code ec;
+        const uint64_t fileBytes = std::filesystem::file_size(path, ec);
+        transfer.preallocate(std::min(*leaves, ec ? 0 : fileBytes / 64));
+    }
+    child.succeeded();
     DecodedGrid decoded = transfer.decode();
     if (!decoded.log.empty()) std::cerr << decoded.log;
     Volume v = wrapGrid(std::move(decoded.grid), path, decoded.activeVoxels);

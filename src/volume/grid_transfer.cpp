@@ -40,7 +40,9 @@ constexpr char kMagic[8] = {'V', 'D', 'B', 'S', 'X', 'F', 'R', '1'};
 constexpr uint64_t kMaxNameBytes = 1 << 16;       ///< grid names longer than this are refused
 constexpr uint64_t kMaxTransformBytes = 1024;     ///< a linear map is at most 4 + 64 + 144 bytes
 constexpr uint64_t kMaxLogBytes = 1 << 16;        ///< the child keeps the first 64 KiB of its log
-constexpr uint64_t kLeafChunk = 4096;             ///< leaves built (in parallel) per chunk: 8.7 MB
+/// Leaves built (in parallel) per chunk: 544 KB, a buffer small enough that its own first-touch
+/// page faults cost little (on the development VM a fault costs ~20-30 µs).
+constexpr uint64_t kLeafChunk = 256;
 
 struct Header {
     char magic[8];
@@ -109,7 +111,7 @@ public:
     }
 
 private:
-    static constexpr size_t kCapacity = 4 << 20;
+    static constexpr size_t kCapacity = 256 << 10;  ///< small: its own page faults are not free
     int fd_;
     std::string label_;
     std::vector<char> buffer_;
@@ -247,21 +249,21 @@ void fillLeaf(const char* record, FloatLeaf& leaf, ValueStats& stats) {
 
 class Decoder {
 public:
-    Decoder(const char* data, uint64_t size, const std::string& label,
-            const std::function<void(uint64_t, uint64_t)>& release)
-        : data_(data), size_(size), label_(label), release_(release) {}
+    Decoder(const TransferSource& source, const std::string& label, std::vector<std::unique_ptr<FloatLeaf>>* pool)
+        : source_(source), size_(source.size), label_(label), pool_(pool) {}
 
     DecodedGrid run() {
-        readHeader();  // everything before the leaves is read first: release() may punch it out
+        readHeader();
         DecodedGrid out;
-        out.log = std::string(data_ + logAt_, h_.logBytes);
+        const std::string strings = bytes(sizeof(Header), tilesAt_ - sizeof(Header));
+        out.log = strings.substr(logAt_ - sizeof(Header), h_.logBytes);
         auto tree = std::make_shared<FloatTree>(h_.background);
         auto grid = openvdb::FloatGrid::create(tree);
-        grid->setTransform(transform());
-        grid->setName(std::string(data_ + sizeof(Header), h_.nameBytes));
+        grid->setTransform(transform(strings.substr(transformAt_ - sizeof(Header), h_.transformBytes)));
+        grid->setName(strings.substr(0, h_.nameBytes));
         grid->setGridClass(openvdb::GridClass(h_.gridClass));
         std::vector<Tile> tiles(h_.tileCount);
-        if (!tiles.empty()) std::memcpy(tiles.data(), data_ + tilesAt_, tiles.size() * sizeof(Tile));
+        if (!tiles.empty()) read(tilesAt_, tiles.size() * sizeof(Tile), tiles.data());
         ValueStats stats;
         buildLeaves(*tree, stats);
         addTiles(*tree, tiles, stats);
@@ -282,9 +284,19 @@ private:
         throw Error(label_ + ": damaged grid transfer (" + what + ")");
     }
 
+    /// @p n bytes at @p offset (both already checked against the size).
+    void read(uint64_t offset, uint64_t n, void* to) const {
+        if (offset > size_ || n > size_ - offset || !source_.read(offset, n, to)) damaged("cannot read it");
+    }
+    std::string bytes(uint64_t offset, uint64_t n) const {
+        std::string text(n, '\0');
+        read(offset, n, text.data());
+        return text;
+    }
+
     void readHeader() {
         if (size_ < sizeof(Header)) damaged("only " + std::to_string(size_) + " bytes");
-        std::memcpy(&h_, data_, sizeof h_);
+        read(0, sizeof h_, &h_);
         if (std::memcmp(h_.magic, kMagic, sizeof kMagic) != 0) damaged("wrong magic");
         if (h_.totalBytes != size_) damaged("size " + std::to_string(size_) + ", header says " + std::to_string(h_.totalBytes));
         if (h_.nameBytes > kMaxNameBytes) damaged("grid name too long");
@@ -304,17 +316,16 @@ private:
     }
 
     /// The transform, after checking that its bytes are one linear map of the known layout.
-    openvdb::math::Transform::Ptr transform() const {
-        const char* p = data_ + transformAt_;
-        const uint64_t n = h_.transformBytes;
+    openvdb::math::Transform::Ptr transform(const std::string& bytes) const {
+        const uint64_t n = bytes.size();
         uint32_t nameLength = 0;
         if (n < 4) damaged("transform");
-        std::memcpy(&nameLength, p, 4);
+        std::memcpy(&nameLength, bytes.data(), 4);
         if (nameLength > 64 || 4 + uint64_t(nameLength) > n) damaged("transform type");
-        const std::string type(p + 4, nameLength);
+        const std::string type = bytes.substr(4, nameLength);
         const uint64_t mapBytes = vdbMapBytes(type);
         if (mapBytes == 0 || 4 + nameLength + mapBytes != n) damaged("transform of type '" + type + "'");
-        std::istringstream in(std::string(p, n));
+        std::istringstream in(bytes);
         openvdb::io::setCurrentVersion(in);
         auto xform = std::make_shared<openvdb::math::Transform>();
         try {
@@ -329,29 +340,28 @@ private:
     void buildLeaves(FloatTree& tree, ValueStats& stats) {
         openvdb::tree::ValueAccessor<FloatTree> acc(tree);
         const float background = h_.background;
+        std::vector<char> chunk(std::min(kLeafChunk, h_.leafCount) * kLeafBytes);
         for (uint64_t first = 0; first < h_.leafCount; first += kLeafChunk) {
             const uint64_t count = std::min(kLeafChunk, h_.leafCount - first);
-            const char* chunk = data_ + leavesAt_ + first * kLeafBytes;
-#ifdef MADV_POPULATE_READ
-            if (release_) {  // one fault-in of the chunk instead of one per page
-                const uintptr_t a = reinterpret_cast<uintptr_t>(chunk) & ~uintptr_t(4095);
-                ::madvise(reinterpret_cast<void*>(a), uintptr_t(chunk) + count * kLeafBytes - a, MADV_POPULATE_READ);
-            }
-#endif
+            read(leavesAt_ + first * kLeafBytes, count * kLeafBytes, chunk.data());
             std::vector<std::unique_ptr<FloatLeaf>> leaves(count);
+            const uint64_t pooled = pool_ && pool_->size() > first ? std::min(count, pool_->size() - first) : 0;
+            for (uint64_t i = 0; i < pooled; ++i) leaves[i] = std::move((*pool_)[first + i]);
             std::atomic<bool> misaligned{false};
             const ValueStats part = tbb::parallel_reduce(
                 tbb::blocked_range<uint64_t>(0, count, 64), ValueStats{},
                 [&](const tbb::blocked_range<uint64_t>& r, ValueStats s) {
                     for (uint64_t i = r.begin(); i != r.end(); ++i) {
-                        const char* record = chunk + i * kLeafBytes;
+                        const char* record = chunk.data() + i * kLeafBytes;
                         int32_t o[3];
                         std::memcpy(o, record, sizeof o);
                         if (((o[0] | o[1] | o[2]) & int32_t(FloatLeaf::DIM - 1)) != 0) {
                             misaligned = true;
                             continue;
                         }
-                        leaves[i] = std::make_unique<FloatLeaf>(openvdb::Coord(o[0], o[1], o[2]), background);
+                        const openvdb::Coord origin(o[0], o[1], o[2]);
+                        if (leaves[i]) leaves[i]->setOrigin(origin);  // allocated (and its pages touched) while the child read
+                        else leaves[i] = std::make_unique<FloatLeaf>(origin, background);
                         fillLeaf(record, *leaves[i], s);
                     }
                     return s;
@@ -363,8 +373,9 @@ private:
             if (misaligned) damaged("leaf origin not on the 8-voxel grid");
             stats.add(part);
             for (auto& leaf : leaves) acc.addLeaf(leaf.release());
-            if (release_) release_(leavesAt_ + first * kLeafBytes, leavesAt_ + (first + count) * kLeafBytes);
+            source_.release(leavesAt_ + first * kLeafBytes, leavesAt_ + (first + count) * kLeafBytes);
         }
+        if (pool_) pool_->clear();  // what the estimate allocated beyond the leaf count
     }
 
     void addTiles(FloatTree& tree, std::vector<Tile>& tiles, ValueStats& stats) {
@@ -387,10 +398,10 @@ private:
         }
     }
 
-    const char* data_;
+    const TransferSource& source_;
     uint64_t size_;
     std::string label_;
-    const std::function<void(uint64_t, uint64_t)>& release_;
+    std::vector<std::unique_ptr<FloatLeaf>>* pool_;
     Header h_{};
     uint64_t transformAt_ = 0, logAt_ = 0, tilesAt_ = 0, leavesAt_ = 0;
 };
@@ -421,7 +432,14 @@ std::vector<char> encodeGridTransfer(const openvdb::GridBase& grid, const std::s
 
 DecodedGrid decodeGridTransfer(const char* data, uint64_t size, const std::string& label,
                                const std::function<void(uint64_t, uint64_t)>& release) {
-    return Decoder(data, size, label, release).run();
+    TransferSource source;
+    source.size = size;
+    source.read = [data](uint64_t offset, uint64_t n, void* to) {
+        std::memcpy(to, data + offset, n);
+        return true;
+    };
+    if (release) source.release = release;
+    return Decoder(source, label, nullptr).run();
 }
 
 TransferMemory::TransferMemory(const std::string& label) : label_(label) {
@@ -433,28 +451,37 @@ TransferMemory::~TransferMemory() {
     if (fd_ >= 0) ::close(fd_);
 }
 
+void TransferMemory::preallocate(uint64_t leaves) {
+    // The memfd's pages too, in one call instead of one allocation per page as the child
+    // writes (beyond the end of the file: its size stays what the child writes).
+    ::fallocate(fd_, FALLOC_FL_KEEP_SIZE, 0, off_t(leaves * kLeafBytes + (1 << 16)));
+    pool_.reserve(leaves);
+    for (uint64_t i = 0; i < leaves; ++i) pool_.push_back(std::make_unique<FloatLeaf>(openvdb::Coord(0), 0.0f));
+}
+
 DecodedGrid TransferMemory::decode() {
     struct stat st {};
     if (::fstat(fd_, &st) != 0) throw Error(label_ + ": cannot hand a grid over (fstat failed)");
-    const uint64_t size = uint64_t(st.st_size);
-    if (size == 0) return decodeGridTransfer(nullptr, 0, label_);
-    void* map = ::mmap(nullptr, size, PROT_READ, MAP_SHARED, fd_, 0);
-    if (map == MAP_FAILED) throw Error(label_ + ": cannot hand a grid over (mmap: " + std::strerror(errno) + ")");
-    // Each chunk of leaves, once in the tree, is punched out of the memfd (and so out of the mapping).
+    TransferSource source;
+    source.size = uint64_t(st.st_size);
+    source.read = [this](uint64_t offset, uint64_t n, void* to) {
+        for (uint64_t done = 0; done < n;) {
+            const ssize_t got = ::pread(fd_, static_cast<char*>(to) + done, n - done, off_t(offset + done));
+            if (got < 0 && errno == EINTR) continue;
+            if (got <= 0) return false;
+            done += uint64_t(got);
+        }
+        return true;
+    };
+    // Each chunk of leaves, once in the tree, is punched out of the memfd: the transfer and
+    // the tree are never both whole in memory.
     uint64_t freed = 0;
-    const auto release = [&](uint64_t, uint64_t end) {
+    source.release = [&](uint64_t, uint64_t end) {
         const uint64_t to = end & ~uint64_t(4095);
         if (to > freed && ::fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, off_t(freed), off_t(to - freed)) == 0)
             freed = to;
     };
-    try {
-        DecodedGrid grid = decodeGridTransfer(static_cast<const char*>(map), size, label_, release);
-        ::munmap(map, size);
-        return grid;
-    } catch (...) {
-        ::munmap(map, size);
-        throw;
-    }
+    return Decoder(source, label_, &pool_).run();
 }
 
 }  // namespace vdbsplat

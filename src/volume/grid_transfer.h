@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,14 @@ std::vector<char> encodeGridTransfer(const openvdb::GridBase& grid, const std::s
 DecodedGrid decodeGridTransfer(const char* data, uint64_t size, const std::string& label,
                                const std::function<void(uint64_t, uint64_t)>& release = {});
 
+/// @brief Where a decoder reads a transfer from: read(offset, bytes, to) false on failure;
+/// release(begin, end) says that bytes before @p end are no longer needed.
+struct TransferSource {
+    uint64_t size = 0;
+    std::function<bool(uint64_t, uint64_t, void*)> read;
+    std::function<void(uint64_t, uint64_t)> release = [](uint64_t, uint64_t) {};
+};
+
 /// @brief An anonymous shared file (memfd) that a forked child writes a transfer into.
 class TransferMemory {
 public:
@@ -54,12 +63,17 @@ public:
     TransferMemory(const TransferMemory&) = delete;
     TransferMemory& operator=(const TransferMemory&) = delete;
     int fd() const { return fd_; }
-    /// @brief Maps what was written and decodes it, releasing memory chunk by chunk.
+    /// @brief Allocates @p leaves float leaves now (touching their pages), for decode() to fill:
+    /// called while the child reads, it takes the parent's page faults off the critical path.
+    void preallocate(uint64_t leaves);
+    /// @brief Decodes what the child wrote (read with pread, chunk by chunk, each chunk
+    /// punched out of the memfd once its leaves are in the tree).
     DecodedGrid decode();
 
 private:
     int fd_ = -1;
     std::string label_;
+    std::vector<std::unique_ptr<openvdb::FloatTree::LeafNodeType>> pool_;
 };
 
 }  // namespace vdbsplat

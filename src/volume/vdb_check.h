@@ -14,6 +14,8 @@
 #include <openvdb/io/File.h>
 
 #include <functional>
+#include <optional>
+#include <sys/types.h>
 #include <sstream>
 #include <string>
 
@@ -37,6 +39,31 @@ void openVdbFile(openvdb::io::File& file, const std::string& path);
 /// @throw Error with the child's message when @p read threw there, or
 /// "<path>: corrupt VDB file (OpenVDB's reader crashed on it: signal N)" when it died.
 void readInChildProcess(const std::string& path, const std::function<void()>& read);
+
+/// @brief A read in a forked child process, as readInChildProcess, that can also send one
+/// number to the parent while it reads (hint(): e.g. a size estimate the parent can act on
+/// meanwhile) and whose success the parent learns before the child has finished exiting.
+class ChildRead {
+public:
+    /// @brief Forks; @p read runs in the child (stderr silenced) and may call its argument once.
+    /// @throw Error when the pipe or the fork fails.
+    ChildRead(const std::string& path, const std::function<void(const std::function<void(uint64_t)>&)>& read);
+    ~ChildRead();  ///< waits for the child to exit
+    ChildRead(const ChildRead&) = delete;
+    ChildRead& operator=(const ChildRead&) = delete;
+    /// @brief Waits for the child's number; none when it finished without sending one.
+    std::optional<uint64_t> hint();
+    /// @brief Returns once the child reported success.
+    /// @throw Error as readInChildProcess.
+    void succeeded();
+
+private:
+    bool receive();
+    int reap();
+    std::string path_, received_;
+    int fd_ = -1, status_ = 0;
+    pid_t pid_ = -1;
+};
 
 /// @brief While alive, what is written to std::cerr (OpenVDB's log) is held back. keep()
 /// writes it out and ends the capture (call it once the read succeeded); destroyed
