@@ -8,9 +8,9 @@
 // rebuilt tree's leaf and active voxel counts against the transfer's). The decoder also
 // does what loadVolume did in a pass of its own: non-finite active values become 0
 // (counted), and the finite active value range is measured, in parallel, as leaves are built.
-// TransferMemory is the memfd the two processes share: the child writes it, the parent maps
-// it and gives back each chunk of leaves (hole punch) once that chunk is in the tree, so the
-// parent never holds the transfer and the tree whole at the same time.
+// TransferMemory is the memfd the two processes share: the child writes it, the parent reads
+// it (pread, chunk by chunk) and gives back each chunk of leaves (hole punch) once that chunk
+// is in the tree, so the transfer and the tree are never both whole in memory.
 #pragma once
 #include <openvdb/openvdb.h>
 
