@@ -5,11 +5,15 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <optional>
+#include <iostream>
 #include <mutex>
 #include <unistd.h>
 
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "volume/grid_transfer.h"
 #include "volume/vdb_check.h"
 
 namespace vdbsplat {
@@ -18,8 +22,21 @@ namespace {
 
 bool isScalarType(const std::string& type) { return type == "float" || type == "double"; }
 
+/// The leaves a grid of @p meta's value type held when written (from the stats metadata that
+/// io::File::write adds: file_mem_bytes); 0 when unknown.
+uint64_t estimatedLeaves(const openvdb::GridBase& meta) {
+    const auto bytes = meta.getMetadata<openvdb::Int64Metadata>("file_mem_bytes");
+    if (!bytes || bytes->value() <= 0) return 0;
+    const uint64_t perLeaf = meta.valueType() == "double"
+                                 ? sizeof(openvdb::DoubleTree::LeafNodeType) + 512 * sizeof(double)
+                                 : sizeof(openvdb::FloatTree::LeafNodeType) + 512 * sizeof(float);
+    return uint64_t(bytes->value()) / perLeaf;
+}
+
 /// Opens @p path and reads the grid to render: @p gridName, or the first float or double grid.
-openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::string& gridName) {
+/// @p hint, if given, gets the grid's estimated leaf count before its values are read.
+openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::string& gridName,
+                                        const std::function<void(uint64_t)>& hint = {}) {
     openvdb::io::File file(path);
     openVdbFile(file, path);
     openvdb::GridBase::Ptr base;
@@ -32,6 +49,7 @@ openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::stri
                     throw Error(path + ": grid '" + gridName + "' holds " + meta->valueType() +
                                 " values; only float and double grids can be rendered");
                 chosen = meta->getName();
+                if (hint) hint(estimatedLeaves(*meta));
                 break;
             }
         }
@@ -46,18 +64,6 @@ openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::stri
     }
     file.close();
     return base;
-}
-
-/// Converts a double grid to a float grid of the same topology, transform and metadata.
-openvdb::FloatGrid::Ptr toFloatGrid(const openvdb::GridBase::Ptr& base) {
-    if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) return f;
-    auto d = openvdb::gridPtrCast<openvdb::DoubleGrid>(base);
-    auto tree = std::make_shared<openvdb::FloatTree>(d->tree());  // value-converting deep copy
-    auto grid = openvdb::FloatGrid::create(tree);
-    grid->setTransform(d->transform().copy());
-    grid->setName(d->getName());
-    grid->setGridClass(d->getGridClass());
-    return grid;
 }
 
 /// The index→world matrix of a linear transform with uniform scale; refuses anything else.
@@ -121,27 +127,65 @@ void Volume::worldBounds(glm::dvec3& lo, glm::dvec3& hi) const {
     }
 }
 
-Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label) {
+namespace {
+
+std::string gridLabel(const std::string& label, const std::string& name) {
+    return label + (name.empty() ? "" : " grid '" + name + "'");
+}
+
+/// A Volume around @p grid of @p activeVoxels active voxels, values not yet sanitized.
+Volume wrapGrid(openvdb::FloatGrid::Ptr grid, const std::string& label, uint64_t activeVoxels) {
     Volume v;
     v.grid = std::move(grid);
     v.name = v.grid->getName();
-    const std::string where = label + (v.name.empty() ? "" : " grid '" + v.name + "'");
+    const std::string where = gridLabel(label, v.name);
     v.indexToWorld = linearUniformMap(v.grid->transform(), where, v.voxelSize);
     v.worldToIndex = glm::inverse(v.indexToWorld);
-    v.activeVoxels = v.grid->activeVoxelCount();
+    v.activeVoxels = activeVoxels;
     if (v.activeVoxels == 0) throw Error(where + ": grid has no active voxels");
     v.indexBox = v.grid->evalActiveVoxelBoundingBox();
+    return v;
+}
+
+}  // namespace
+
+Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label) {
+    const uint64_t active = grid->activeVoxelCount();
+    Volume v = wrapGrid(std::move(grid), label, active);
     sanitizeValues(v);
     return v;
 }
 
+// The grid is read once, in a forked child (OpenVDB's reader can crash on damaged data:
+// there that is a one-line Error here), which hands it over as a float tree through a
+// memfd (volume/grid_transfer.h); the parent allocates the leaves meanwhile, then rebuilds
+// the tree, checking every byte, and sanitizes its values as it goes. OpenVDB's log lines are captured in the child and
+// written here only when the read succeeded, as before; this process's stderr is never redirected.
 Volume loadVolume(const std::string& path, const std::string& gridName) {
     initOpenVdb();
-    OpenVdbLogCapture log;  // OpenVDB's warnings about a bad file stay out of its one-line error
-    readInChildProcess(path, [&] { readGridToRender(path, gridName); });  // a crash there is an Error here
-    const openvdb::GridBase::Ptr base = readGridToRender(path, gridName);
-    log.keep();
-    Volume v = makeVolume(toFloatGrid(base), path);
+    TransferMemory transfer(path);
+    ChildRead child(path, [&](const std::function<void(uint64_t)>& hint) {
+        OpenVdbLogCapture log;
+        const openvdb::GridBase::Ptr base = readGridToRender(path, gridName, hint);
+        double voxelSize = 0.0;  // refuse what the parent would refuse, before handing it over
+        linearUniformMap(base->transform(), gridLabel(path, base->getName()), voxelSize);
+        encodeGridTransfer(*base, log.held(), transfer.fd(), path);
+    });
+    // While the child reads, allocate the leaves it estimates (their page faults are most of
+    // what building a tree costs), at most one per 64 bytes of file: each leaf's value mask
+    // is stored there uncompressed.
+    if (const std::optional<uint64_t> leaves = child.hint()) {
+        std::error_code ec;
+        const uint64_t fileBytes = std::filesystem::file_size(path, ec);
+        transfer.preallocate(std::min(*leaves, ec ? 0 : fileBytes / 64));
+    }
+    child.succeeded();
+    DecodedGrid decoded = transfer.decode();
+    if (!decoded.log.empty()) std::cerr << decoded.log;
+    Volume v = wrapGrid(std::move(decoded.grid), path, decoded.activeVoxels);
+    v.nonFiniteCount = decoded.nonFiniteCount;
+    v.valueMin = decoded.valueMin;
+    v.valueMax = decoded.valueMax;
     v.file = path;
     return v;
 }

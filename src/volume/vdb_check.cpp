@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -101,17 +102,6 @@ void skipMetadata(Reader& r, uint64_t end) {
     }
 }
 
-/// Bytes of a map's data after its type name (math/Maps.cc: ScaleMap reads five Vec3d,
-/// ScaleTranslateMap six, TranslationMap one, AffineMap and UnitaryMap a Mat4d); 0 for
-/// others (a frustum map: variable), which end the check there.
-uint64_t mapBytes(const std::string& type) {
-    if (type == "UniformScaleMap" || type == "ScaleMap") return 5 * 24;
-    if (type == "UniformScaleTranslateMap" || type == "ScaleTranslateMap") return 6 * 24;
-    if (type == "TranslationMap") return 24;
-    if (type == "AffineMap" || type == "UnitaryMap") return 128;
-    return 0;
-}
-
 /// Bytes of a tree's value type from the grid type ("Tree_float_5_4_3"); 0 when unknown.
 uint64_t valueBytes(const std::string& gridType) {
     static const std::pair<const char*, uint64_t> kTypes[] = {
@@ -132,7 +122,7 @@ void checkGridHeader(Reader& r, uint32_t version, const std::string& gridType, u
     if (version >= kGridCompressionVersion) r.value<uint32_t>("grid compression flags");
     skipMetadata(r, blockPos);
     if (version >= kInstancingVersion) {  // older files put the topology first
-        const uint64_t map = mapBytes(r.string("grid transform type"));
+        const uint64_t map = vdbMapBytes(r.string("grid transform type"));
         const uint64_t value = valueBytes(gridType);
         if (map > 0 && value > 0) {
             r.skip(map, "grid transform");
@@ -164,6 +154,16 @@ void checkGridDescriptors(Reader& r, uint32_t version) {
 }
 
 }  // namespace
+
+// math/Maps.cc: ScaleMap reads five Vec3d, ScaleTranslateMap six, TranslationMap one,
+// AffineMap and UnitaryMap a Mat4d.
+uint64_t vdbMapBytes(const std::string& type) {
+    if (type == "UniformScaleMap" || type == "ScaleMap") return 5 * 24;
+    if (type == "UniformScaleTranslateMap" || type == "ScaleTranslateMap") return 6 * 24;
+    if (type == "TranslationMap") return 24;
+    if (type == "AffineMap" || type == "UnitaryMap") return 128;
+    return 0;
+}
 
 void checkVdbStructure(const std::string& path) {
     std::error_code ec;
@@ -207,58 +207,112 @@ void OpenVdbLogCapture::keep() {
     std::cerr << held_.str();
 }
 
-void readInChildProcess(const std::string& path, const std::function<void()>& read) {
+// The pipe carries messages: 'H' + 8 bytes (a hint), then 'K' (success) or 'E' + text (an Error).
+ChildRead::ChildRead(const std::string& path, const std::function<void(const std::function<void(uint64_t)>&)>& read)
+    : path_(path) {
     int fds[2];
     if (::pipe(fds) != 0) throw Error(path + ": cannot check the file (pipe failed)");
     std::cout.flush();
     std::cerr.flush();
-    const pid_t pid = ::fork();
-    if (pid < 0) {
+    pid_ = ::fork();
+    if (pid_ < 0) {
         ::close(fds[0]);
         ::close(fds[1]);
         throw Error(path + ": cannot check the file (fork failed)");
     }
-    if (pid == 0) {  // the child: read, report, and leave without running any destructor
+    if (pid_ == 0) {  // the child: read, report, and leave without running any destructor
         ::close(fds[0]);
-        // Silence the child: the parent's own read reports OpenVDB's warnings, and glibc's
-        // "free(): invalid size" on a heap OpenVDB corrupted must not add a line either
+        // Silence the child: OpenVDB's std::cerr lines are the caller's to capture and pass on,
+        // and glibc's "free(): invalid size" on a heap OpenVDB corrupted must not add a line
         // (LIBC_FATAL_STDERR_ keeps it off the terminal, the null fd 2 swallows it).
         std::ostringstream quiet;
         std::cerr.rdbuf(quiet.rdbuf());
         ::setenv("LIBC_FATAL_STDERR_", "1", 1);
         if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) ::dup2(null, 2);
+        const auto send = [&](const std::string& bytes) {
+            for (size_t done = 0; done < bytes.size();) {
+                const ssize_t n = ::write(fds[1], bytes.data() + done, bytes.size() - done);
+                if (n < 0 && errno == EINTR) continue;
+                if (n <= 0) break;
+                done += size_t(n);
+            }
+        };
+        bool hinted = false;
+        const auto hint = [&](uint64_t n) {
+            if (hinted) return;
+            hinted = true;
+            std::string m(9, 'H');
+            std::memcpy(m.data() + 1, &n, 8);
+            send(m);
+        };
         std::string message;
         try {
-            read();
+            read(hint);
         } catch (const std::exception& e) {
             message = e.what();
         } catch (...) {
             message = path + ": corrupt VDB file";
         }
-        for (size_t done = 0; done < message.size();) {
-            const ssize_t n = ::write(fds[1], message.data() + done, message.size() - done);
-            if (n <= 0) break;
-            done += size_t(n);
-        }
+        send(message.empty() ? "K" : "E" + message.substr(0, 4096));
         ::_exit(message.empty() ? 0 : 1);
     }
     ::close(fds[1]);
-    std::string message;
+    fd_ = fds[0];
+}
+
+bool ChildRead::receive() {
     char buffer[4096];
-    for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) != 0;) {
+    for (;;) {
+        const ssize_t n = ::read(fd_, buffer, sizeof buffer);
         if (n < 0 && errno == EINTR) continue;
-        if (n < 0) break;
-        if (message.size() < 4096) message.append(buffer, size_t(n));
+        if (n <= 0) return false;
+        if (received_.size() < 8192) received_.append(buffer, size_t(n));
+        return true;
     }
-    ::close(fds[0]);
-    int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+}
+
+std::optional<uint64_t> ChildRead::hint() {
+    while (received_.empty() || (received_[0] == 'H' && received_.size() < 9))
+        if (!receive()) break;
+    if (received_.size() < 9 || received_[0] != 'H') return std::nullopt;
+    uint64_t n = 0;
+    std::memcpy(&n, received_.data() + 1, 8);
+    received_.erase(0, 9);
+    return n;
+}
+
+void ChildRead::succeeded() {
+    for (;;) {
+        if (received_.size() >= 9 && received_[0] == 'H') received_.erase(0, 9);  // a hint not asked for
+        if (received_ == "K") return;  // the child may still be exiting: the destructor reaps it
+        if (!receive()) break;
     }
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
-    if (WIFEXITED(status) && !message.empty()) throw Error(message);
+    const int status = reap();
+    if (WIFEXITED(status) && WEXITSTATUS(status) != 0 && received_.size() > 1 && received_[0] == 'E')
+        throw Error(received_.substr(1));
     const int signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
-    throw Error(path + ": corrupt VDB file (OpenVDB's reader crashed on it: " +
+    throw Error(path_ + ": corrupt VDB file (OpenVDB's reader crashed on it: " +
                 (signal ? "signal " + std::to_string(signal) : "exit " + std::to_string(WEXITSTATUS(status))) + ")");
+}
+
+int ChildRead::reap() {
+    if (fd_ >= 0) {
+        ::close(fd_);
+        fd_ = -1;
+    }
+    if (pid_ > 0) {
+        while (::waitpid(pid_, &status_, 0) < 0 && errno == EINTR) {
+        }
+        pid_ = -1;
+    }
+    return status_;
+}
+
+ChildRead::~ChildRead() { reap(); }
+
+void readInChildProcess(const std::string& path, const std::function<void()>& read) {
+    ChildRead child(path, [&](const std::function<void(uint64_t)>&) { read(); });
+    child.succeeded();
 }
 
 }  // namespace vdbsplat

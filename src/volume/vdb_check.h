@@ -14,6 +14,8 @@
 #include <openvdb/io/File.h>
 
 #include <functional>
+#include <optional>
+#include <sys/types.h>
 #include <sstream>
 #include <string>
 
@@ -22,6 +24,10 @@ namespace vdbsplat {
 /// @brief Checks that @p path looks like a complete VDB file (magic, header, descriptors, grid extents).
 /// @throw Error "<path>: not a VDB file …" or "<path>: truncated or corrupt VDB file (…)".
 void checkVdbStructure(const std::string& path);
+
+/// @brief Bytes of a linear map's data after its type name in OpenVDB's stream layout
+/// (Transform::write: type name, then the map); 0 for other maps (a frustum: variable).
+uint64_t vdbMapBytes(const std::string& mapType);
 
 /// @brief Checks that @p path exists and is a regular file, runs checkVdbStructure, then
 /// opens @p file without delayed loading (so a truncated file fails here, not mid-render).
@@ -34,6 +40,31 @@ void openVdbFile(openvdb::io::File& file, const std::string& path);
 /// "<path>: corrupt VDB file (OpenVDB's reader crashed on it: signal N)" when it died.
 void readInChildProcess(const std::string& path, const std::function<void()>& read);
 
+/// @brief A read in a forked child process, as readInChildProcess, that can also send one
+/// number to the parent while it reads (hint(): e.g. a size estimate the parent can act on
+/// meanwhile) and whose success the parent learns before the child has finished exiting.
+class ChildRead {
+public:
+    /// @brief Forks; @p read runs in the child (stderr silenced) and may call its argument once.
+    /// @throw Error when the pipe or the fork fails.
+    ChildRead(const std::string& path, const std::function<void(const std::function<void(uint64_t)>&)>& read);
+    ~ChildRead();  ///< waits for the child to exit
+    ChildRead(const ChildRead&) = delete;
+    ChildRead& operator=(const ChildRead&) = delete;
+    /// @brief Waits for the child's number; none when it finished without sending one.
+    std::optional<uint64_t> hint();
+    /// @brief Returns once the child reported success.
+    /// @throw Error as readInChildProcess.
+    void succeeded();
+
+private:
+    bool receive();
+    int reap();
+    std::string path_, received_;
+    int fd_ = -1, status_ = 0;
+    pid_t pid_ = -1;
+};
+
 /// @brief While alive, what is written to std::cerr (OpenVDB's log) is held back. keep()
 /// writes it out and ends the capture (call it once the read succeeded); destroyed
 /// without keep() — the read threw and its Error says what went wrong — it is dropped.
@@ -45,6 +76,8 @@ public:
     OpenVdbLogCapture(const OpenVdbLogCapture&) = delete;
     OpenVdbLogCapture& operator=(const OpenVdbLogCapture&) = delete;
     void keep();
+    /// @brief What was held back so far.
+    std::string held() const { return held_.str(); }
 
 private:
     std::ostringstream held_;
