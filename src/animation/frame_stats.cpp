@@ -234,7 +234,7 @@ std::string plotSvg(const std::vector<FrameRecord>& records, const std::string& 
         const double y = ly + 14.0 * double(k);
         s << "<line x1=\"" << lx << "\" y1=\"" << y << "\" x2=\"" << lx + 20 << "\" y2=\"" << y << "\" stroke=\""
           << items[k].colour << "\" stroke-width=\"2\"" << (*items[k].dash ? std::string(" stroke-dasharray=\"") + items[k].dash + "\"" : "")
-          << "/><text x=\"" << lx + 26 << "\" y=\"" << y + 4 << "\">" << items[k].label << "</text>\n";
+          << "/><text x=\"" << lx + 26 << "\" y=\"" << y + 4 << "\">" << esc(items[k].label) << "</text>\n";
     }
     s << "</svg>\n";
     return s.str();

@@ -74,7 +74,8 @@ TEST(FramesCsv, RoundTrip) {
         const auto back = parseCsvRow(row, ref);
         ASSERT_TRUE(back) << row;
         EXPECT_EQ(csvRow(*back, ref), row);
-        EXPECT_EQ(std::count(row.begin(), row.end(), ','), std::count(csvHeader(ref).begin(), csvHeader(ref).end(), ','));
+        const std::string header = csvHeader(ref);
+        EXPECT_EQ(std::count(row.begin(), row.end(), ','), std::count(header.begin(), header.end(), ','));
     }
     r.flicker.reset();  // first frame
     r.distance = NAN;   // keyframes

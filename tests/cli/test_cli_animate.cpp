@@ -133,7 +133,9 @@ TEST_F(AnimateCli, ResumeKeepsFramesAndRerendersADeletedOne) {
     const auto a = lines(csvBefore), b = lines(slurp(dir + "/frames.csv"));
     ASSERT_EQ(a.size(), b.size());
     for (size_t i = 0; i < a.size(); ++i)
-        if (i != 3) EXPECT_EQ(a[i], b[i]);
+        if (i != 3) {
+            EXPECT_EQ(a[i], b[i]);
+        }
     // A damaged frame is not kept either.
     spit(dir + "/frame_0001.png", "not a png");
     const CliResult r2 = animate(args + " --resume");
@@ -194,8 +196,11 @@ TEST_F(AnimateCli, ReferenceWritesPsnrFlickerAndPlot) {
         const auto f = fields(csv[i]);
         ASSERT_EQ(f.size(), 15u) << csv[i];
         EXPECT_GT(std::stod(f[12]), 15.0) << csv[i];  // PSNR
-        if (i == 1) EXPECT_EQ(f[13], "");             // no flicker for the first frame
-        else EXPECT_GE(std::stod(f[13]), 0.0);
+        if (i == 1) {
+            EXPECT_EQ(f[13], "");  // no flicker for the first frame
+        } else {
+            EXPECT_GE(std::stod(f[13]), 0.0);
+        }
         EXPECT_GT(std::stod(f[14]), 0.0);  // the reference was rendered
     }
     EXPECT_EQ(countFiles(dir + "/reference", "frame_"), 3u);
