@@ -4,7 +4,10 @@
 // non-empty folder, orbit and keyframe paths, --reference's PSNR/flicker columns and plot,
 // --force, the --mp4 note, Ctrl-C between frames, and bad input: one line, exit 1, no output.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -19,6 +22,8 @@
 
 #include "image/image.h"
 #include "support/cli.h"
+
+extern char** environ;
 
 namespace vdbsplat {
 namespace {
@@ -271,27 +276,45 @@ TEST_F(AnimateCli, BadInputOneLineNoOutput) {
     test::expectOneLineError(animate("-o '" + out("file") + "' --orbit 90 --frames 2"), "not a folder");
 }
 
-TEST_F(AnimateCli, InterruptedBetweenFrames) {
-    const std::string dir = out("int");
-    const std::string cmd = std::string("'") + VDBSPLAT_BINARY + "' animate '" + vdb() + "' -o '" + dir +
-                            "' --from 8 --to 0.5 --frames 3000 --size 16x16 --threads 1 >'" + out("o.txt") +
-                            "' 2>'" + out("e.txt") + "' & echo $! >'" + out("pid") + "'; wait";
-    std::thread runner([&] { std::system(cmd.c_str()); });
+/// Starts animate (no shell: SIGINT and SIGTERM at their default, as in a terminal), waits for
+/// its fourth frame, sends @p sig, and checks the interruption contract.
+void interruptAndCheck(const std::string& vdbPath, const test::ScratchDir& scratch, int sig) {
+    const std::string tag = std::to_string(sig);
+    const std::string dir = scratch.path("int" + tag), outPath = scratch.path("o" + tag), errPath = scratch.path("e" + tag);
+    std::vector<std::string> all{VDBSPLAT_BINARY, "animate", vdbPath, "-o", dir, "--from", "8", "--to", "0.5",
+                                 "--frames", "3000", "--size", "16x16", "--threads", "1"};
+    std::vector<char*> argv;
+    for (std::string& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    sigset_t defaults;
+    sigemptyset(&defaults);
+    sigaddset(&defaults, SIGINT);
+    sigaddset(&defaults, SIGTERM);
+    posix_spawnattr_setsigdefault(&attr, &defaults);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
     pid_t pid = 0;
-    for (int i = 0; i < 400 && pid == 0; ++i) {
+    ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, &attr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+    posix_spawnattr_destroy(&attr);
+    for (int i = 0; i < 1200 && !fs::exists(dir + "/frame_0003.png"); ++i)
         std::this_thread::sleep_for(std::chrono::milliseconds(25));
-        const std::string p = slurp(out("pid"));
-        if (!p.empty() && p.back() == '\n') pid = std::stoi(p);
+    ::kill(pid, sig);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
-    ASSERT_GT(pid, 0);
-    for (int i = 0; i < 800 && !fs::exists(dir + "/frame_0003.png"); ++i)
-        std::this_thread::sleep_for(std::chrono::milliseconds(25));
-    ::kill(pid, SIGTERM);  // a background job of sh ignores SIGINT, and keeps ignoring it
-    runner.join();
-    const std::string err = slurp(out("e.txt"));
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+    const std::string err = slurp(errPath);
     EXPECT_EQ(err.rfind("vdbsplat: error: interrupted after ", 0), 0u) << err;
     EXPECT_NE(err.find(" of 3000 frames"), std::string::npos) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_TRUE(slurp(outPath).empty());
     test::expectNoTemporaries(dir);
     const size_t frames = countFiles(dir, "frame_");
     EXPECT_GE(frames, 4u);
@@ -304,6 +327,9 @@ TEST_F(AnimateCli, InterruptedBetweenFrames) {
         EXPECT_EQ(readImage(dir + name).width, 16) << name;
     }
 }
+
+TEST_F(AnimateCli, InterruptedByCtrlCBetweenFrames) { interruptAndCheck(vdb(), local_, SIGINT); }
+TEST_F(AnimateCli, InterruptedBySigtermBetweenFrames) { interruptAndCheck(vdb(), local_, SIGTERM); }
 
 }  // namespace
 }  // namespace vdbsplat
