@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -141,12 +142,14 @@ TEST_F(AnimateCli, ResumeKeepsFramesAndRerendersADeletedOne) {
         if (i != 3) {
             EXPECT_EQ(a[i], b[i]);
         }
-    // A damaged frame is not kept either.
+    // A damaged frame is not kept either, and a temporary left by a killed writer is removed.
     spit(dir + "/frame_0001.png", "not a png");
+    spit(dir + "/frame_0003.png.tmp4242.png", "partial");
     const CliResult r2 = animate(args + " --resume");
     ASSERT_EQ(r2.rc, 0) << r2.err;
     EXPECT_NE(r2.out.find("(1 rendered, 3 kept)"), std::string::npos) << r2.out;
     EXPECT_EQ(readImage(dir + "/frame_0001.png").width, 32);
+    EXPECT_FALSE(fs::exists(dir + "/frame_0003.png.tmp4242.png"));
     // --resume with other settings is refused.
     test::expectOneLineError(animate(args + " --resume --threshold 2"), "another animation");
     // --force starts afresh, and a shorter run leaves no stale frames behind.
@@ -239,15 +242,18 @@ TEST_F(AnimateCli, BadInputOneLineNoOutput) {
         {std::string(5000, '[') + std::string(5000, ']'), "nested deeper"},
         {"[{\"eye\":[7.5,7.5,40],\"look_at\":[7.5,7.5,7.5],\"time\":0}]", "parallel"},  // up along the view
     };
-    int n = 0;
-    for (const auto& [text, needle] : files) {
-        const std::string path = out("bad" + std::to_string(n++) + ".json");
-        spit(path, text);
-        const std::string dir = out("never");
-        const CliResult r = animate("-o '" + dir + "' --path '" + path + "' --frames 2 --size 16x16");
-        test::expectOneLineError(r, needle, text.substr(0, 60));
-        EXPECT_NE(r.err.find(path), std::string::npos) << r.err;
-        EXPECT_FALSE(fs::exists(dir)) << text.substr(0, 60);
+    struct Case {
+        std::string args, needle, context;
+        bool namesFile = false;
+        CliResult result;
+    };
+    std::vector<Case> cases;
+    const std::string never = out("never");
+    for (size_t n = 0; n < files.size(); ++n) {
+        const std::string path = out("bad" + std::to_string(n) + ".json");
+        spit(path, files[n].first);
+        cases.push_back({"-o '" + never + "' --path '" + path + "' --frames 2 --size 16x16", files[n].second,
+                         files[n].first.substr(0, 60), true, {}});
     }
     const std::vector<std::pair<std::string, std::string>> flags = {
         {"--from 4 --to 1 --frames 0", "--frames"},
@@ -266,14 +272,28 @@ TEST_F(AnimateCli, BadInputOneLineNoOutput) {
         {"--path '/nonexistent/p.json' --frames 4", "/nonexistent/p.json"},
         {"--path '/nonexistent/p.json'", "--frames"},
     };
-    for (const auto& [args, needle] : flags) {
-        const std::string dir = out("never");
-        test::expectOneLineError(animate("-o '" + dir + "' " + args), needle, args);
-        EXPECT_FALSE(fs::exists(dir)) << args;
-    }
-    test::expectOneLineError(animate("-o '/nonexistent/x/y' --orbit 90 --frames 2"), "parent folder");
+    for (const auto& [args, needle] : flags) cases.push_back({"-o '" + never + "' " + args, needle, args, false, {}});
     spit(out("file"), "x");
-    test::expectOneLineError(animate("-o '" + out("file") + "' --orbit 90 --frames 2"), "not a folder");
+    cases.push_back({"-o '/nonexistent/x/y' --orbit 90 --frames 2", "parent folder", "parent", false, {}});
+    cases.push_back({"-o '" + out("file") + "' --orbit 90 --frames 2", "not a folder", "file", false, {}});
+    // Each run is a separate process (mostly start-up time): four at a time, each with its own log folder.
+    std::atomic<size_t> next{0};
+    std::vector<std::thread> pool;
+    for (int t = 0; t < 4; ++t)
+        pool.emplace_back([&, t] {
+            const fs::path logs = local_.dir() / ("logs" + std::to_string(t));
+            fs::create_directories(logs);
+            for (size_t i; (i = next++) < cases.size();)
+                cases[i].result = test::runVdbsplat("animate '" + vdb() + "' " + cases[i].args, logs);
+        });
+    for (auto& th : pool) th.join();
+    for (const Case& c : cases) {
+        test::expectOneLineError(c.result, c.needle, c.context);
+        if (c.namesFile) {
+            EXPECT_NE(c.result.err.find(out("bad")), std::string::npos) << c.result.err;
+        }
+    }
+    EXPECT_FALSE(fs::exists(never));
 }
 
 /// Starts animate (no shell: SIGINT and SIGTERM at their default, as in a terminal), waits for
