@@ -4,7 +4,7 @@
 set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config git
       libopenvdb-dev libboost-iostreams-dev libopenimageio-dev libglm-dev libtbb-dev
-      libgtest-dev libbenchmark-dev nlohmann-json3-dev zlib1g-dev)
+      libgtest-dev libbenchmark-dev nlohmann-json3-dev zlib1g-dev libhwy-dev)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

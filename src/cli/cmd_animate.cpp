@@ -94,6 +94,7 @@ const char* kHelp =
     "  --distance K       orbit: framing distance (default 1)\n"
     "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
     "  --lod PX           level-of-detail cell size in pixels (default 1; 0: off; see render --help)\n"
+    "  --simd on|off      splats through the vector loop (default on) or the scalar table path\n"
     "  --footprint P      auto (default) | table | exact (see render --help)\n"
     "  --show-primitives  tint splats red\n"
     "  --tables DIR       footprint and reindex tables (see render --help)\n"

@@ -56,6 +56,7 @@ const char* kHelp =
     "  --up X,Y,Z           up vector (default 0,0,1)\n"
     "  --threshold PX       minification threshold of hybrid mode in pixels (default 1)\n"
     "  --lod PX             level-of-detail cell size in pixels (default 1; 0: off; see render --help)\n"
+    "  --simd on|off        vector splat loop (default on) or the scalar table path\n"
     "  --footprint P        auto (default) | table | exact (see render --help)\n"
     "  --json FILE.json     also write every run, the per-stage medians and the ratios as JSON\n"
     "  -v                   print each run to stderr and the per-stage medians to stdout\n";
@@ -140,6 +141,10 @@ Options optionsFrom(const Args& args) {
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
     if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
+    if (auto v = args.get("--simd")) {
+        if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
+        s.simd = *v == "on";
+    }
     if (auto v = args.get("--view-dir")) {
         const auto d = parseDoubleList(*v, "--view-dir", 3);
         s.camera.hasViewDir = true;
@@ -205,7 +210,7 @@ std::string formatDistance(double d) {
 int runBench(const Argv& argv) {
     const Args args(argv,
                     {"--grid", "--tf", "--size", "--runs", "--warmup", "--threads", "--modes", "--distances",
-                     "--threshold", "--lod", "--footprint", "--json", "--view-dir", "--up"},
+                     "--threshold", "--lod", "--simd", "--footprint", "--json", "--view-dir", "--up"},
                     {"-v"});
     if (args.wantsHelp()) {
         std::cout << kHelp;

@@ -10,7 +10,7 @@ const std::set<std::string>& renderValueFlags() {
     static const std::set<std::string> flags{"--grid",   "--mode",      "--size",      "--tf",    "--eye",
                                              "--look-at", "--up",       "--view-dir",  "--fov",   "--distance",
                                              "--threads", "--spp",      "--threshold", "--lod",   "--footprint",
-                                             "--tables"};
+                                             "--tables",  "--simd"};
     return flags;
 }
 
@@ -32,6 +32,10 @@ RenderSettings settingsFromFlags(const Args& args) {
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
     if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
+    if (auto v = args.get("--simd")) {
+        if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
+        s.simd = *v == "on";
+    }
     s.showPrimitives = args.has("--show-primitives");
     if (auto v = args.get("--tables")) {
         if (v->empty()) throw Error("--tables: expected a directory, got ''");

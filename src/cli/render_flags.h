@@ -1,6 +1,6 @@
 // cli/render_flags.h — the render flags shared by `vdbsplat render` and `vdbsplat animate`.
 // Owns: turning --mode, --size, --tf, --grid, --fov, --distance, --threads, --spp,
-// --threshold, --footprint, --lod, --show-primitives, --tables, --up, --view-dir, --eye and
+// --threshold, --footprint, --lod, --simd, --show-primitives, --tables, --up, --view-dir, --eye and
 // --look-at into validated RenderSettings, the same way for every command that renders
 // (a command that does not declare a flag never sees it: Args refuses it first).
 #pragma once

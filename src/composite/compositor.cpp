@@ -12,6 +12,7 @@
 #include <cmath>
 
 #include "composite/opacity.h"
+#include "composite/splat_raster.h"
 #include "footprint/kernel.h"
 
 namespace vdbsplat {
@@ -40,7 +41,7 @@ TileCompositor::TileCompositor(int width, int height, const Tables& tables, cons
     : width_(width), height_(height), tilesX_((width + kTileSize - 1) / kTileSize),
       tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact),
       color_(size_t(width) * height, glm::vec3(0.f)), transmittance_(size_t(width) * height, 1.f),
-      liveCount_(size_t(tilesX_) * tilesY_), bins_(size_t(tilesX_) * tilesY_) {
+      liveCount_(size_t(tilesX_) * tilesY_) {
     for (int ty = 0; ty < tilesY_; ++ty)
         for (int tx = 0; tx < tilesX_; ++tx)
             liveCount_[size_t(ty) * tilesX_ + tx] = (std::min(width_, (tx + 1) * kTileSize) - tx * kTileSize) *
@@ -60,7 +61,7 @@ Image TileCompositor::image() const {
     return image;
 }
 
-SkippedPrimitives TileCompositor::composite(const std::vector<Primitive>& prims, double& binSeconds, double& compositeSeconds) {
+SkippedPrimitives TileCompositor::composite(std::span<const Primitive> prims, double& binSeconds, double& compositeSeconds) {
     const auto t0 = Clock::now();
     int64_t slabBase = std::numeric_limits<int64_t>::max();
     for (const Primitive& p : prims)
@@ -74,71 +75,124 @@ SkippedPrimitives TileCompositor::composite(const std::vector<Primitive>& prims,
         if (p.kind != PrimitiveKind::Culled && !p.range.empty()) order_.push_back({sortKey(p, slabBase), i});
     }
     tbb::parallel_sort(order_.begin(), order_.end());  // a total order: the result is unique
-    sorted_.resize(order_.size());
+    if (sorted_.size() < order_.size()) sorted_.resize(order_.size());  // grows only: no per-window construction
+    sortedCount_ = order_.size();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, order_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t k = r.begin(); k < r.end(); ++k) sorted_[k] = prims[order_[k].index];
     });
-    SkippedPrimitives skipped;
-    for (auto& bin : bins_) bin.clear();
-    for (uint32_t k = 0; k < sorted_.size(); ++k) {
-        const Primitive& p = sorted_[k];
-        bool any = false;
-        for (int ty = p.range.y0 / kTileSize; ty <= p.range.y1 / kTileSize; ++ty)
-            for (int tx = p.range.x0 / kTileSize; tx <= p.range.x1 / kTileSize; ++tx) {
-                const size_t tile = size_t(ty) * tilesX_ + tx;
-                if (liveCount_[tile] == 0) continue;
-                bins_[tile].push_back(k);
-                any = true;
-            }
-        if (!any) {
-            ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
-            if (p.kind == PrimitiveKind::SplatExactIndex) ++skipped.exactIndexSplats;
-            skipped.voxels += p.members;
-        }
-    }
+    const SkippedPrimitives skipped = binToTiles();
     binSeconds += since(t0);
     const auto t1 = Clock::now();
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX_ * tilesY_, 1), [&](const tbb::blocked_range<int>& r) {
-        for (int tile = r.begin(); tile < r.end(); ++tile)
-            if (!bins_[tile].empty()) compositeTile(tile, bins_[tile]);
+        for (int tile = r.begin(); tile < r.end(); ++tile) {
+            const std::span<const uint32_t> bin(binEntries_.data() + binStart_[size_t(tile)],
+                                                binStart_[size_t(tile) + 1] - binStart_[size_t(tile)]);
+            if (!bin.empty()) compositeTile(tile, bin);
+        }
     });
     compositeSeconds += since(t1);
     return skipped;
 }
 
+/// Bins sorted_ into per-tile lists (CSR: binStart_, binEntries_), each list ascending in
+/// sorted_ position, skipping tiles that are already opaque. Parallel over fixed chunks of
+/// sorted_: count per (chunk, tile), prefix sums, fill; the lists do not depend on the chunking.
+SkippedPrimitives TileCompositor::binToTiles() {
+    const size_t tiles = size_t(tilesX_) * tilesY_, n = sortedCount_;
+    const size_t chunks = std::clamp<size_t>(n / 16384, 1, 16), per = (n + chunks - 1) / chunks;
+    std::vector<uint32_t>& counts = binCounts_;  // reused: fresh pages cost a fault each on every window
+    counts.assign(chunks * tiles, 0);
+    std::vector<SkippedPrimitives> skippedIn(chunks);
+    const auto forTiles = [&](const Primitive& p, auto&& fn) {
+        for (int ty = p.range.y0 / kTileSize; ty <= p.range.y1 / kTileSize; ++ty)
+            for (int tx = p.range.x0 / kTileSize; tx <= p.range.x1 / kTileSize; ++tx) {
+                const size_t tile = size_t(ty) * tilesX_ + tx;
+                if (liveCount_[tile] > 0) fn(tile);
+            }
+    };
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+        uint32_t* count = counts.data() + c * tiles;
+        SkippedPrimitives& skipped = skippedIn[c];
+        for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k) {
+            const Primitive& p = sorted_[k];
+            bool any = false;
+            forTiles(p, [&](size_t tile) { ++count[tile], any = true; });
+            if (!any) {
+                ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
+                if (p.kind == PrimitiveKind::SplatExactIndex) ++skipped.exactIndexSplats;
+                skipped.voxels += p.members;
+            }
+        }
+    });
+    // Offsets: tile by tile, chunk by chunk; counts become each chunk's write cursor.
+    binStart_.assign(tiles + 1, 0);
+    size_t total = 0;
+    for (size_t tile = 0; tile < tiles; ++tile) {
+        binStart_[tile] = total;
+        for (size_t c = 0; c < chunks; ++c) {
+            const uint32_t k = counts[c * tiles + tile];
+            counts[c * tiles + tile] = uint32_t(total);
+            total += k;
+        }
+    }
+    binStart_[tiles] = total;
+    binEntries_.resize(total);
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+        uint32_t* cursor = counts.data() + c * tiles;
+        for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k)
+            forTiles(sorted_[k], [&](size_t tile) { binEntries_[cursor[tile]++] = uint32_t(k); });
+    });
+    SkippedPrimitives skipped;
+    for (const SkippedPrimitives& s : skippedIn) {
+        skipped.points += s.points, skipped.splats += s.splats;
+        skipped.exactIndexSplats += s.exactIndexSplats, skipped.voxels += s.voxels;
+    }
+    return skipped;
+}
+
 /// One tile's pixels, row-major with stride kTileSize, in the thread compositing it: the
 /// hot loops touch a few KiB that stay in L1, and the image is written back once per window.
+/// Structure of arrays (T, R, G, B), 64-byte aligned, so the splat loop loads whole rows.
 struct TileCompositor::TilePixels {
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  // inclusive image rectangle of the tile
-    std::array<float, kTileSize * kTileSize> T;
-    std::array<glm::vec3, kTileSize * kTileSize> C;
+    alignas(64) std::array<float, kTileSize * kTileSize> T;
+    alignas(64) std::array<float, kTileSize * kTileSize> R;
+    alignas(64) std::array<float, kTileSize * kTileSize> G;
+    alignas(64) std::array<float, kTileSize * kTileSize> B;
 
     static int local(int x, int y, int x0, int y0) { return (y - y0) * kTileSize + (x - x0); }
     int local(int x, int y) const { return local(x, y, x0, y0); }
     bool live(int i) const { return T[size_t(i)] >= kTransmittanceEpsilon; }
+    /// Pixels with T ≥ ε; those past the image's edge hold T = 0. One branch-free pass over
+    /// the whole array, which the compiler vectorises (it runs every 32 primitives).
     int countLive() const {
         int n = 0;
-        for (int y = y0; y <= y1; ++y)
-            for (int x = x0; x <= x1; ++x) n += live(local(x, y));
+        for (size_t i = 0; i < T.size(); ++i) n += T[i] >= kTransmittanceEpsilon ? 1 : 0;
         return n;
     }
+    TileBuffers buffers() { return {T.data(), R.data(), G.data(), B.data(), x0, y0}; }
     /// α = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α   (DESIGN §4)
     void over(int i, float tau, const glm::vec3& color) {
         const float alpha = opacityFromOpticalDepth(tau);
         float& t = T[size_t(i)];
-        C[size_t(i)] += t * alpha * color;
+        R[size_t(i)] += t * alpha * color.x;
+        G[size_t(i)] += t * alpha * color.y;
+        B[size_t(i)] += t * alpha * color.z;
         t *= 1.f - alpha;
     }
 };
 
-void TileCompositor::compositeTile(int tile, const std::vector<uint32_t>& entries) {
+void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) {
     TilePixels px;
     px.x0 = (tile % tilesX_) * kTileSize, px.y0 = (tile / tilesX_) * kTileSize;
     px.x1 = std::min(width_, px.x0 + kTileSize) - 1, px.y1 = std::min(height_, px.y0 + kTileSize) - 1;
+    px.T.fill(0.f);  // pixels past the image's edge: finished (T = 0), never drawn
+    px.R.fill(0.f), px.G.fill(0.f), px.B.fill(0.f);
     for (int y = px.y0; y <= px.y1; ++y)
         for (int x = px.x0; x <= px.x1; ++x) {
-            px.T[size_t(px.local(x, y))] = transmittance_[size_t(y) * width_ + x];
-            px.C[size_t(px.local(x, y))] = color_[size_t(y) * width_ + x];
+            const size_t i = size_t(px.local(x, y)), k = size_t(y) * width_ + x;
+            px.T[i] = transmittance_[k];
+            px.R[i] = color_[k].x, px.G[i] = color_[k].y, px.B[i] = color_[k].z;
         }
     SlabBuffer slab;
     int64_t slabOf = std::numeric_limits<int64_t>::min();
@@ -175,8 +229,9 @@ void TileCompositor::compositeTile(int tile, const std::vector<uint32_t>& entrie
     flush();
     for (int y = px.y0; y <= px.y1; ++y)
         for (int x = px.x0; x <= px.x1; ++x) {
-            transmittance_[size_t(y) * width_ + x] = px.T[size_t(px.local(x, y))];
-            color_[size_t(y) * width_ + x] = px.C[size_t(px.local(x, y))];
+            const size_t i = size_t(px.local(x, y)), k = size_t(y) * width_ + x;
+            transmittance_[k] = px.T[i];
+            color_[k] = glm::vec3(px.R[i], px.G[i], px.B[i]);
         }
     liveCount_[tile] = px.countLive();
 }
@@ -197,16 +252,35 @@ void TileCompositor::drawPoint(const Primitive& p, const TilePixels& px, SlabBuf
 }
 
 void TileCompositor::drawSplat(const Primitive& p, TilePixels& px) const {
-    // SplatExactIndex (--footprint auto, far off the axis): the exact index d instead of the
-    // affine one, as an affine map set up once per tile from the kernel's view position.
     const bool exactIndex = p.kind == PrimitiveKind::SplatExactIndex;
-    ExactIndexMap map;
-    if (exactIndex) {
-        const SphereProjection sphere =
-            projectSphere(*exact_.camera, ViewPoint(p.viewPos), Kernel::kRadius * exact_.voxelSize);
-        if (!sphere.isEllipse()) return drawExact(p, px);  // borderline in float: the half-ray fallback
-        map = makeExactIndexMap(makeScreenKernel(sphere), sphere, PixelCoord(p.centre));
+    if (exactIndex && !p.hasExactMap) return drawExact(p, px);  // borderline in float: the half-ray fallback
+    if (exact_.vector && (exactIndex || tables_.poly.covers(p.sin2Alpha))) {
+        SplatRaster s;
+        s.cx = p.centre.x, s.cy = p.centre.y;
+        s.qxx = p.conic.x, s.qxy = p.conic.y, s.qyy = p.conic.z;
+        s.scale = p.scale;
+        s.coef = exactIndex ? tables_.poly.axisRow() : tables_.poly.row(p.sin2Alpha);
+        s.exactIndex = exactIndex;
+        s.map = p.exactMap;
+        s.color = p.color;
+        s.x0 = std::max(p.range.x0, px.x0), s.x1 = std::min(p.range.x1, px.x1);
+        s.y0 = std::max(p.range.y0, px.y0), s.y1 = std::min(p.range.y1, px.y1);
+        s.epsilon = kTransmittanceEpsilon;
+        drawSplatVector(s, px.buffers());
+        return;
     }
+    drawSplatTables(p, px);
+}
+
+void TileCompositor::drawSplatTables(const Primitive& p, TilePixels& px) const {
+    // SplatExactIndex (--footprint auto, far off the axis): the exact index d instead of the
+    // affine one, from the affine map set up once at projection (ExactIndexMap).
+    const bool exactIndex = p.kind == PrimitiveKind::SplatExactIndex;
+    const ExactIndexMap& map = p.exactMap;
+    SplatShader shader;  // the table path's per-splat state (screen_kernel.h)
+    shader.row = tables_.reindex.row(p.alpha);
+    shader.footprint = &tables_.footprint;
+    shader.scale = p.scale;
     const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
     const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
     const float qxx = p.conic.x, qxy = p.conic.y, qyy = p.conic.z;
@@ -226,8 +300,7 @@ void TileCompositor::drawSplat(const Primitive& p, TilePixels& px) const {
             const float dx = float(x) + 0.5f - p.centre.x;
             const float i2 = qxx * dx * dx + 2.f * qxy * dx * dy + qyy * dy * dy;
             if (!(i2 < 1.f)) continue;
-            const float tau = exactIndex ? p.shader.depositAtD2(map.d2(dx, dy))
-                                         : p.shader.depositAtIndex2(i2);
+            const float tau = exactIndex ? shader.depositAtD2(map.d2(dx, dy)) : shader.depositAtIndex2(i2);
             px.over(i, tau, p.color);
         }
     }

@@ -13,6 +13,7 @@
 // The order inside a tile is a total order independent of threads, so the image
 // does not depend on the thread count.
 #pragma once
+#include <span>
 #include <vector>
 
 #include "composite/primitive.h"
@@ -31,6 +32,9 @@ inline constexpr float kTransmittanceEpsilon = 1e-4f;
 struct ExactContext {
     const Camera* camera = nullptr;
     double voxelSize = 1.0;
+    /// Splats through the vector loop (composite/splat_raster.h, polynomial footprint); false:
+    /// the scalar table path, the oracle it is tested against.
+    bool vector = true;
 };
 
 /// Primitives composite() dropped because every tile they touch is already opaque.
@@ -46,7 +50,7 @@ public:
 
     /// @brief Composites @p prims (one depth window, any order) behind everything before.
     /// @return the primitives skipped because every tile they touch is opaque.
-    SkippedPrimitives composite(const std::vector<Primitive>& prims, double& binSeconds, double& compositeSeconds);
+    SkippedPrimitives composite(std::span<const Primitive> prims, double& binSeconds, double& compositeSeconds);
 
     /// @brief True if every pixel of the inclusive rectangle is already opaque (T < ε).
     bool hidden(int x0, int y0, int x1, int y1) const;
@@ -62,9 +66,11 @@ private:
     };
     struct SlabBuffer;
     struct TilePixels;  // one tile's transmittance and colour, copied in and out (thread-local)
-    void compositeTile(int tile, const std::vector<uint32_t>& entries);
+    SkippedPrimitives binToTiles();
+    void compositeTile(int tile, std::span<const uint32_t> entries);
     void drawPoint(const Primitive& p, const TilePixels& tile, SlabBuffer& slab) const;
     void drawSplat(const Primitive& p, TilePixels& tile) const;
+    void drawSplatTables(const Primitive& p, TilePixels& tile) const;
     void drawExact(const Primitive& p, TilePixels& tile) const;
 
     int width_, height_, tilesX_, tilesY_;
@@ -75,8 +81,11 @@ private:
     std::vector<float> transmittance_;
     std::vector<int> liveCount_;          // per tile: pixels with T ≥ ε
     std::vector<Entry> order_;            // the window's drawable primitives in (key, index) order
-    std::vector<Primitive> sorted_;       // ... gathered in that order
-    std::vector<std::vector<uint32_t>> bins_;  // per tile: positions in sorted_, ascending
+    std::vector<Primitive> sorted_;       // ... gathered in that order (the first sortedCount_)
+    size_t sortedCount_ = 0;
+    std::vector<size_t> binStart_;        // per tile (+1): its list in binEntries_
+    std::vector<uint32_t> binEntries_;    // per tile: positions in sorted_, ascending
+    std::vector<uint32_t> binCounts_;     // binToTiles' per-(chunk, tile) counts and cursors
 };
 
 }  // namespace vdbsplat

@@ -36,7 +36,12 @@ struct Primitive {
     float total = 0.f;          ///< Σ_pixels τ (DESIGN §4 energy rule)
     // Splat (table path)
     glm::vec3 conic{0.f};       ///< Q as (Qxx, Qxy, Qyy): i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²
-    SplatShader shader;
+    float scale = 0.f;          ///< σ_k·h·amplitude (SplatShader::scale)
+    float alpha = 0.f;          ///< half cone angle (the table path's reindex row)
+    float sin2Alpha = 0.f;      ///< sin²α (the vector loop's polynomial row)
+    // SplatExactIndex: the exact d² as an affine map of the pixel (δ from `centre`), set up once
+    ExactIndexMap exactMap;
+    bool hasExactMap = false;
     // SplatExact / NearEye (recomputed from these per tile; they are rare or a diagnostic)
     glm::vec3 viewPos{0.f};
     float sigma = 0.f;          ///< extinction per voxel length

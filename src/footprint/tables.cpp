@@ -314,7 +314,7 @@ ReindexTable parseReindexTable(const std::string& bytes, const std::string& name
     return ReindexTable(std::move(v), nI2, nAlpha, dom[1], p.number("max_abs_error"), p.number("error_bound"));
 }
 
-Tables buildTables() { return {FootprintTable::build(), ReindexTable::build()}; }
+Tables buildTables() { return {FootprintTable::build(), ReindexTable::build(), FootprintPolynomials::build()}; }
 
 std::filesystem::path defaultTablesDir() { return std::filesystem::path(VDBSPLAT_SOURCE_DIR) / "tables"; }
 
@@ -328,7 +328,8 @@ void saveTables(const Tables& tables, const std::filesystem::path& dir) {
 
 Tables loadTables(const std::filesystem::path& dir) {
     const std::filesystem::path fp = dir / kFootprintTableFile, ri = dir / kReindexTableFile;
-    return {parseFootprintTable(readFile(fp), fp.string()), parseReindexTable(readFile(ri), ri.string())};
+    return {parseFootprintTable(readFile(fp), fp.string()), parseReindexTable(readFile(ri), ri.string()),
+            FootprintPolynomials::build()};
 }
 
 Tables loadOrBuildTables(const std::filesystem::path& dir) {
@@ -336,6 +337,7 @@ Tables loadOrBuildTables(const std::filesystem::path& dir) {
     Tables t;
     t.footprint = std::filesystem::exists(fp) ? parseFootprintTable(readFile(fp), fp.string()) : FootprintTable::build();
     t.reindex = std::filesystem::exists(ri) ? parseReindexTable(readFile(ri), ri.string()) : ReindexTable::build();
+    t.poly = FootprintPolynomials::build();
     return t;
 }
 

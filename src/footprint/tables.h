@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "footprint/footprint_poly.h"
+
 namespace vdbsplat {
 
 inline constexpr int kTableFormatVersion = 1;              ///< bump when the file layout changes
@@ -114,10 +116,12 @@ private:
     double maxAbsError_ = 0.0, errorBound_ = 0.0;
 };
 
-/// @brief Both tables; the renderer holds one by value and passes it by const reference.
+/// @brief Both tables (and the vector loop's polynomial fits of their composition, built in
+/// memory: footprint_poly.h); the renderer holds one by value and passes it by const reference.
 struct Tables {
     FootprintTable footprint;
     ReindexTable reindex;
+    FootprintPolynomials poly;
 };
 
 /// @brief Max |lookup − closed form| of @p t over a dense deterministic sampling

@@ -24,7 +24,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
                                  : settings.mode == RenderMode::Splat ? 0.0
                                                                       : settings.threshold;
     VoxelStream stream(volume, camera, table, streamOptions);
-    TileCompositor compositor(camera.width(), camera.height(), tables, ExactContext{&camera, volume.voxelSize});
+    TileCompositor compositor(camera.width(), camera.height(), tables, ExactContext{&camera, volume.voxelSize, settings.simd});
     const ProjectionContext ctx{camera,          tables,           volume.voxelSize,  stream.slabLength(),
                                 settings.mode,   settings.threshold, settings.footprint, settings.showPrimitives};
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
@@ -36,8 +36,8 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
         if (!stream.next(batch, hidden)) break;
         stats.streamSeconds += since(t);
         t = Clock::now();
-        projectBatch(batch, ctx, prims);
-        for (const Primitive& p : prims) {
+        const std::span<const Primitive> window = projectBatch(batch, ctx, prims);
+        for (const Primitive& p : window) {
             if (p.kind == PrimitiveKind::Point) ++stats.points;
             else if (p.kind != PrimitiveKind::Culled) ++stats.splats;
             if (p.kind == PrimitiveKind::SplatExactIndex) ++stats.exactIndexSplats;
@@ -47,7 +47,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
             }
         }
         stats.projectSeconds += since(t);
-        const SkippedPrimitives hiddenPrims = compositor.composite(prims, stats.rasterizeSeconds, stats.compositeSeconds);
+        const SkippedPrimitives hiddenPrims = compositor.composite(window, stats.rasterizeSeconds, stats.compositeSeconds);
         stats.points -= hiddenPrims.points;
         stats.splats -= hiddenPrims.splats;
         stats.exactIndexSplats -= hiddenPrims.exactIndexSplats;

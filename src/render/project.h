@@ -5,6 +5,7 @@
 // the near-eye fallback (footprint/ellipse.h). Runs in parallel; primitive i
 // always comes from voxel i, so the order stays deterministic.
 #pragma once
+#include <span>
 #include <vector>
 
 #include "camera/camera.h"
@@ -31,8 +32,11 @@ struct ProjectionContext {
     bool showPrimitives;
 };
 
-/// @brief Projects every voxel of @p batch into @p prims (resized to the batch size).
-void projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, std::vector<Primitive>& prims);
+/// @brief Projects every voxel of @p batch into the first batch.size() elements of @p prims
+/// (grown when needed, never shrunk: the buffer is reused window after window).
+/// @return the primitives of this batch, prims[0 … batch.size()).
+std::span<const Primitive> projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx,
+                                        std::vector<Primitive>& prims);
 
 /// @brief Projects one voxel (view-space centre @p c, extinction per voxel length @p sigma).
 /// @param spreadPx2 a level-of-detail aggregate's projected second moment (px², added to

@@ -86,6 +86,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["footprint"] = toString(footprint);
     j["show_primitives"] = showPrimitives;
     j["lod"] = lodPx;
+    j["simd"] = simd;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
     return j;
 }

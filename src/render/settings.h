@@ -41,6 +41,9 @@ struct RenderSettings {
     /// Level of detail for minified voxels (DESIGN §8.2): points are aggregated over cells of
     /// 2, 4 or 8 voxels per side whose side projects to at most this many pixels; 0: off.
     double lodPx = 1.0;
+    /// Splats through the vector loop (Highway, polynomial footprint); false: the scalar table
+    /// path it is tested against (same image to ~1e−6; for measuring).
+    bool simd = true;
     std::string tablesDir;                  ///< footprint/reindex tables; empty: defaultTablesDir()
     StreamOptions stream;                   ///< how the grid is streamed: speed and memory, never the image
 

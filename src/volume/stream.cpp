@@ -23,6 +23,15 @@ void appendRange(std::vector<T>& dst, const std::vector<T>& src, size_t begin, s
 }
 }  // namespace
 
+void VoxelBatch::resize(size_t n) {
+    viewPos.resize(n);
+    distance.resize(n);
+    sigma.resize(n);
+    color.resize(n);
+    spread.resize(n);
+    members.resize(n);
+}
+
 void VoxelBatch::clear() {
     viewPos.clear();
     distance.clear();
@@ -270,25 +279,29 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                 slabEnd = int64_t(std::floor(blocks_[nextBlock_].dMin / slabLength_)) + slabsPerWindow_;
         }
         // Activate the blocks whose front the window reached: extract them in parallel, in order.
-        std::vector<VoxelBatch> extracted(nextBlock_ - first);
-        std::vector<char> skipped(nextBlock_ - first, 0);
+        // The per-block buffers are reused window after window (no allocation once warm).
+        const size_t count = nextBlock_ - first;
+        if (extracted_.size() < count) extracted_.resize(count);
+        skipped_.assign(count, 0);
         tbb::parallel_for(tbb::blocked_range<size_t>(first, nextBlock_, 16), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 const Block& b = blocks_[i];
+                VoxelBatch& e = extracted_[i - first];
+                e.clear();
                 if (hidden) {
                     int x0, y0, x1, y1;
                     screenRect(b, x0, y0, x1, y1);
                     if (hidden(x0, y0, x1, y1)) {
-                        skipped[i - first] = 1;
+                        skipped_[i - first] = 1;
                         continue;
                     }
                 }
-                extract(b, extracted[i - first]);
+                extract(b, e);
             }
         });
         for (size_t i = first; i < nextBlock_; ++i) {
-            const VoxelBatch& e = extracted[i - first];
-            if (skipped[i - first]) counts_.occluded += blocks_[i].voxels;
+            const VoxelBatch& e = extracted_[i - first];
+            if (skipped_[i - first]) counts_.occluded += blocks_[i].voxels;
             if (blocks_[i].lodLevel > 0) {
                 counts_.aggregates += e.size();
                 for (uint32_t n : e.members) counts_.aggregatedVoxels += n;
@@ -300,19 +313,28 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
             appendRange(pending_.spread, e.spread, 0, e.size());
             appendRange(pending_.members, e.members, 0, e.size());
         }
-        // Release the pending voxels inside the window; keep the rest in order.
+        // Release the pending voxels inside the window; compact the rest in place, in order.
         const float limit = float(slabEnd * slabLength_);
-        VoxelBatch keep;
+        size_t kept = 0;
         for (size_t i = 0; i < pending_.size(); ++i) {
-            VoxelBatch& dst = pending_.distance[i] < limit ? batch : keep;
-            dst.viewPos.push_back(pending_.viewPos[i]);
-            dst.distance.push_back(pending_.distance[i]);
-            dst.sigma.push_back(pending_.sigma[i]);
-            dst.color.push_back(pending_.color[i]);
-            dst.spread.push_back(pending_.spread[i]);
-            dst.members.push_back(pending_.members[i]);
+            if (pending_.distance[i] < limit) {
+                batch.viewPos.push_back(pending_.viewPos[i]);
+                batch.distance.push_back(pending_.distance[i]);
+                batch.sigma.push_back(pending_.sigma[i]);
+                batch.color.push_back(pending_.color[i]);
+                batch.spread.push_back(pending_.spread[i]);
+                batch.members.push_back(pending_.members[i]);
+            } else {
+                pending_.viewPos[kept] = pending_.viewPos[i];
+                pending_.distance[kept] = pending_.distance[i];
+                pending_.sigma[kept] = pending_.sigma[i];
+                pending_.color[kept] = pending_.color[i];
+                pending_.spread[kept] = pending_.spread[i];
+                pending_.members[kept] = pending_.members[i];
+                ++kept;
+            }
         }
-        pending_ = std::move(keep);
+        pending_.resize(kept);
         batch.slabBegin = nextSlab_;
         batch.slabEnd = slabEnd;
         nextSlab_ = slabEnd;

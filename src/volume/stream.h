@@ -39,7 +39,8 @@ struct VoxelBatch {
     int64_t slabBegin = 0;           ///< first slab of the window: slab = floor(distance / (h·slabThickness))
     int64_t slabEnd = 0;             ///< one past the last slab
     size_t size() const { return viewPos.size(); }
-    void clear();
+    void clear();           ///< empties every array, keeping their capacity
+    void resize(size_t n);  ///< every array to @p n records
 };
 
 struct StreamOptions {
@@ -113,6 +114,8 @@ private:
     std::vector<Block> blocks_;   // sorted by dMin
     size_t nextBlock_ = 0;
     VoxelBatch pending_;          // voxels of activated blocks not yet released
+    std::vector<VoxelBatch> extracted_;  // per activated block of the window (reused)
+    std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
     int64_t nextSlab_ = 0;
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
     glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)

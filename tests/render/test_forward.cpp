@@ -336,6 +336,69 @@ TEST(Forward, ZoomThroughTheSwitchDoesNotPop) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Level of detail (DESIGN §8.2): aggregates keep the energy, the image, and the zoom smooth
+
+// Far away the aggregates replace most points, and the image stays what the voxels give.
+TEST(Forward, LevelOfDetailKeepsTheFarImage) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    for (const double distance : {8.0, 4.0}) {
+        RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        RenderStats on, off;
+        const Image a = renderWith(marschnerLobb(), tf, s, &on);
+        s.lodPx = 0.0;
+        const Image b = renderWith(marschnerLobb(), tf, s, &off);
+        const double psnr = compareImages(a, b).psnr;
+        std::printf("  distance %.0f: %llu points for %llu (%llu aggregates of %llu voxels), LOD vs none %.1f dB\n",
+                    distance, (unsigned long long)on.points, (unsigned long long)off.points,
+                    (unsigned long long)on.lodAggregates, (unsigned long long)on.lodVoxels, psnr);
+        EXPECT_EQ(off.lodAggregates, 0u);
+        EXPECT_GT(on.lodAggregates, 0u);
+        EXPECT_LT(on.points * 4, off.points);   // it did aggregate
+        EXPECT_EQ(on.culled, off.culled);       // and every voxel is still accounted for
+        EXPECT_GT(psnr, 60.0);
+    }
+}
+
+// Energy: at low opacity the image's alpha is ≈ the deposited optical depth, which the aggregates
+// must keep exactly (total mass Σσ at the centroid). A lost or doubled voxel would show here.
+TEST(Forward, LevelOfDetailKeepsTheEnergy) {
+    const TransferFunction tf = constantTf(0.001f);
+    RenderSettings s = settingsFor(RenderMode::Hybrid, 6.0);
+    RenderStats on;
+    const Image a = renderWith(marschnerLobb(), tf, s, &on);
+    s.lodPx = 0.0;
+    const Image b = renderWith(marschnerLobb(), tf, s);
+    double sa = 0.0, sb = 0.0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) sa += a.pixels[i].w, sb += b.pixels[i].w;
+    ASSERT_GT(on.lodAggregates, 0u);
+    EXPECT_NEAR(sa / sb, 1.0, 2e-4);
+}
+
+// A zoom from far to near crosses the level changes (8³ → 4³ → 2³ → voxels) and then the point/splat
+// switch: every frame with LOD agrees with the frame without it, so no level change pops.
+TEST(Forward, ZoomThroughTheLevelsDoesNotPop) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    constexpr int kFrames = 10;
+    double worst = INFINITY, firstMembers = 0.0, lastMembers = 0.0;
+    for (int k = 0; k < kFrames; ++k) {
+        const double distance = 24.0 * std::pow(1.2 / 24.0, double(k) / (kFrames - 1));
+        RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        RenderStats st;
+        const Image lod = renderWith(marschnerLobb(), tf, s, &st);
+        s.lodPx = 0.0;
+        const Image none = renderWith(marschnerLobb(), tf, s);
+        const double members = st.lodAggregates ? double(st.lodVoxels) / double(st.lodAggregates) : 1.0;
+        (k == 0 ? firstMembers : lastMembers) = members;
+        const double psnr = compareImages(lod, none).psnr;
+        worst = std::min(worst, psnr);
+        std::printf("  frame %d, distance %.2f: %.1f voxels per point, LOD vs none %.1f dB\n", k, distance, members, psnr);
+    }
+    EXPECT_GT(firstMembers, 100.0);  // 8³ cells at the far end
+    EXPECT_EQ(lastMembers, 1.0);     // no aggregates at the near end
+    EXPECT_GT(worst, 55.0);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Determinism and diagnostics
 
 TEST(Forward, ImagesDoNotDependOnThreadCount) {

@@ -1,0 +1,51 @@
+// composite/splat_raster.h — one splat's per-pixel loop over one tile, vectorised across pixels.
+// Owns: SplatRaster (everything the loop needs, in float, prepared once per splat and tile),
+// TileBuffers (a tile's transmittance and premultiplied colour, structure of arrays), and
+// drawSplatVector, the Google Highway loop with runtime dispatch (SSE4, AVX2, AVX-512, NEON…
+// whichever the CPU has; one binary runs everywhere).
+//
+// Per pixel it computes what the compositor's scalar table path does (TileCompositor::drawSplat
+// with the tables, kept as the oracle the tests compare against), except that the footprint is
+// the polynomial of footprint_poly.h instead of two dependent table lookups:
+//     i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²        (the widened conic, screen_kernel.h)
+//     t  = i² (table path) or the exact d² (ExactIndexMap, --footprint auto off the axis)
+//     τ  = scale · √(1 − t) · G_α(t)             (scale = σ·h·amplitude; DESIGN §3, §4)
+//     α  = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α  (DESIGN §4, front to back)
+// Pixels with i² ≥ 1, outside the splat's clipped range or already opaque (T < ε) keep their values.
+#pragma once
+#include <glm/glm.hpp>
+
+#include "footprint/footprint_poly.h"
+#include "footprint/screen_kernel.h"
+
+namespace vdbsplat {
+
+/// @brief One tile's pixels: row-major, stride 16 (kTileSize), 64-byte aligned arrays.
+struct TileBuffers {
+    float* T;          ///< transmittance
+    float* R;          ///< premultiplied radiance, per channel
+    float* G;
+    float* B;
+    int x0 = 0, y0 = 0;  ///< image coordinates of the tile's first pixel
+};
+
+struct SplatRaster {
+    float cx = 0.f, cy = 0.f;             ///< widened ellipse centre (pixels)
+    float qxx = 0.f, qxy = 0.f, qyy = 0.f;  ///< conic Q
+    float scale = 0.f;                    ///< σ·h·amplitude
+    FootprintPolynomials::Coefficients coef{};  ///< G_α (or the axis row for the exact index)
+    bool exactIndex = false;              ///< t from `map` (exact d²) instead of i²
+    ExactIndexMap map;                    ///< δ measured from (cx, cy)
+    glm::vec3 color{0.f};
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  ///< inclusive image pixels, inside the tile
+    float epsilon = 0.f;                  ///< pixels with T < epsilon are finished
+};
+
+/// @brief Composites @p s "over" the pixels of @p tile (front to back).
+void drawSplatVector(const SplatRaster& s, const TileBuffers& tile);
+
+/// @brief The same loop one pixel at a time, in the same float operations (tests: the vector
+/// loop must agree with it to float rounding).
+void drawSplatScalarPoly(const SplatRaster& s, const TileBuffers& tile);
+
+}  // namespace vdbsplat

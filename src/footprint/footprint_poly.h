@@ -1,0 +1,54 @@
+// footprint/footprint_poly.h — the splat footprint F(d(i, α)) as one polynomial per splat.
+// Owns: FootprintPolynomials, the vector loop's replacement for the two dependent table
+// lookups of the (i, α) path (i² → reindex row → footprint table), and its error bound.
+//
+// The maths (DESIGN §3, kernel.h): with t = i² and d² = t / (cos²α + t·sin²α) (the corrected
+// reindex), the truncated Gaussian's footprint is
+//     F = N·s_g·√(π/2)·exp(−R²d²/2s_g²) · 2·erf(R·√(1−d²)/(√2·s_g)),
+// and since erf(b√u)/√u is an entire function of u and 1 − d² = cos²α·(1 − t)/(cos²α + t·sin²α),
+//     F(t, α) = √(1 − t) · G_α(t)     with G_α analytic on [0, 1] for α ≤ 15°.
+// G_α is fitted by a degree-10 polynomial in x = 2t − 1 (interpolation at Chebyshev nodes,
+// Σ|c_k| ≈ G(0), so float Horner loses nothing to cancellation) on 33 rows uniform in sin²α
+// ∈ [0, sin²15°]; a splat interpolates its coefficients linearly between two rows once, and
+// every pixel then costs √(1 − t) and 10 FMAs, vectorisable, no gathers.
+// The α = 0 row is F as a function of d² itself: the exact-index path uses it.
+// Measured bound (FootprintPoly tests): |F_poly − F| ≤ kErrorBound·F(0), evaluated in float.
+#pragma once
+#include <array>
+#include <vector>
+
+namespace vdbsplat {
+
+class FootprintPolynomials {
+public:
+    static constexpr int kDegree = 10;
+    static constexpr int kCoefficients = kDegree + 1;
+    static constexpr int kRows = 32;                ///< intervals in sin²α
+    static constexpr double kAlphaMaxDeg = 15.0;    ///< beyond: the table path (closed-form reindex)
+    static constexpr double kErrorBound = 1.0e-6;   ///< relative to F(0); measured ≈ 5e−7
+
+    using Coefficients = std::array<float, kCoefficients>;  ///< c_0 … c_10 in x = 2t − 1
+
+    /// @brief Fits every row from Kernel::footprint (deterministic, in memory, well under 1 ms).
+    static FootprintPolynomials build();
+
+    /// @brief True when a splat of half cone angle with sin²α = @p sin2Alpha is covered.
+    bool covers(double sin2Alpha) const { return sin2Alpha >= 0.0 && sin2Alpha <= sin2Max_; }
+    /// @brief The coefficients for sin²α = @p sin2Alpha (must be covered): rows interpolated linearly.
+    Coefficients row(double sin2Alpha) const;
+    /// @brief The α = 0 row: F as a polynomial in d² (for the exact-index path).
+    const Coefficients& axisRow() const { return rows_.front(); }
+
+    /// @brief √(1 − t)·Σ c_k (2t − 1)^k in float, as the vector loop computes it; 0 for t ≥ 1.
+    static float evaluate(const Coefficients& c, float t);
+
+    double sin2Max() const { return sin2Max_; }
+    /// @brief Max |evaluate − Kernel::footprint| / F(0) over a dense sampling of t and α.
+    double measureError() const;
+
+private:
+    std::vector<Coefficients> rows_;  // kRows + 1
+    double sin2Max_ = 0.0;
+};
+
+}  // namespace vdbsplat

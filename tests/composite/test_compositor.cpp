@@ -1,0 +1,275 @@
+// tests/composite/test_compositor.cpp — the tile compositor and the projection stage against
+// slow, obvious implementations (../shared/STYLE.md, gsplat: an oracle beside every fast path):
+//   - the Highway splat loop against the same maths one pixel at a time;
+//   - TileCompositor (binning, sorting, tiles, slab buffers, early termination) against a
+//     per-pixel loop over every primitive in (slab, points before splats, depth, index) order;
+//   - projectBatch against projectVoxel called voxel by voxel.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "composite/compositor.h"
+#include "composite/opacity.h"
+#include "composite/splat_raster.h"
+#include "footprint/kernel.h"
+#include "pointfilter/point_filter.h"
+#include "render/project.h"
+
+namespace vdbsplat {
+namespace {
+
+const Tables& tables() {
+    static const Tables t = buildTables();
+    return t;
+}
+
+Camera testCamera(int size) {
+    CameraSpec spec;
+    spec.width = spec.height = size;
+    return makeCamera(spec, glm::dvec3(-8.0), glm::dvec3(8.0));
+}
+
+struct TileArrays {
+    alignas(64) std::array<float, 256> T, R, G, B;
+    TileBuffers buffers(int x0, int y0) { return {T.data(), R.data(), G.data(), B.data(), x0, y0}; }
+};
+
+// Random splats over one tile: the vector loop equals the scalar loop to float rounding, for the
+// table index and for the exact index, with some pixels already finished (T < ε).
+TEST(SplatRaster, VectorLoopMatchesTheScalarLoop) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    const Camera camera = testCamera(64);
+    double worst = 0.0;
+    int drawn = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        // A real kernel sphere in front of the camera, possibly off-axis and near.
+        const glm::dvec3 c((u(rng) - 0.5f) * 6.0, (u(rng) - 0.5f) * 6.0, 6.0 + u(rng) * 30.0);
+        const SphereProjection sphere = projectSphere(camera, ViewPoint(c), Kernel::kRadius * (0.2 + u(rng)));
+        if (!sphere.isEllipse()) continue;
+        const ScreenKernel k = makeScreenKernel(sphere);
+        SplatRaster s;
+        s.cx = float(k.centre.x), s.cy = float(k.centre.y);
+        s.qxx = float(k.conic[0][0]), s.qxy = float(k.conic[0][1]), s.qyy = float(k.conic[1][1]);
+        s.scale = 0.05f + 3.f * u(rng);
+        s.exactIndex = trial % 2 == 1;
+        const double sin2 = (sphere.r / sphere.D) * (sphere.r / sphere.D);
+        if (!s.exactIndex && !tables().poly.covers(sin2)) continue;
+        s.coef = s.exactIndex ? tables().poly.axisRow() : tables().poly.row(sin2);
+        s.map = makeExactIndexMap(k, sphere, PixelCoord(s.cx, s.cy));
+        s.color = glm::vec3(u(rng), u(rng), u(rng));
+        s.epsilon = kTransmittanceEpsilon;
+        // The tile under the ellipse centre, clipped.
+        const int tx0 = std::clamp(int(std::floor(s.cx / 16.f)), 0, 3) * 16, ty0 = std::clamp(int(std::floor(s.cy / 16.f)), 0, 3) * 16;
+        const PixelRange r = pixelRange(k.bounds, 64, 64);
+        s.x0 = std::max(r.x0, tx0), s.x1 = std::min(r.x1, tx0 + 15);
+        s.y0 = std::max(r.y0, ty0), s.y1 = std::min(r.y1, ty0 + 15);
+        if (s.x0 > s.x1 || s.y0 > s.y1) continue;
+        TileArrays a, b;
+        for (size_t i = 0; i < 256; ++i) {
+            a.T[i] = u(rng) < 0.1f ? 0.5f * kTransmittanceEpsilon : u(rng);
+            a.R[i] = u(rng), a.G[i] = u(rng), a.B[i] = u(rng);
+        }
+        b = a;
+        const TileArrays before = a;
+        drawSplatVector(s, a.buffers(tx0, ty0));
+        drawSplatScalarPoly(s, b.buffers(tx0, ty0));
+        for (size_t i = 0; i < 256; ++i) {
+            if (b.T[i] != a.T[i] || b.R[i] != a.R[i]) ++drawn;
+            worst = std::max({worst, double(std::abs(a.T[i] - b.T[i])), double(std::abs(a.R[i] - b.R[i])),
+                              double(std::abs(a.G[i] - b.G[i])), double(std::abs(a.B[i] - b.B[i]))});
+            // Finished pixels and pixels outside the range stay exactly as they were.
+            const int x = tx0 + int(i % 16), y = ty0 + int(i / 16);
+            const bool outside = x < s.x0 || x > s.x1 || y < s.y0 || y > s.y1;
+            if (outside || before.T[i] < kTransmittanceEpsilon) {
+                ASSERT_EQ(a.T[i], before.T[i]) << "trial " << trial << " pixel " << i;
+                ASSERT_EQ(b.T[i], before.T[i]) << "trial " << trial << " pixel " << i;
+            }
+        }
+    }
+    std::printf("  max |vector − scalar| = %.3g over %d changed values\n", worst, drawn);
+    EXPECT_GT(drawn, 1000);  // the loops did draw
+    EXPECT_LT(worst, 2e-6);
+}
+
+/// The slow compositor: every pixel walks every primitive in the compositor's order
+/// (slab, points before splats, depth, index); points of a slab are summed, then composited
+/// (DESIGN §4); splats are composited one by one with the table path's deposit.
+Image slowComposite(const std::vector<std::vector<Primitive>>& windows, int w, int h) {
+    Image image(w, h);
+    std::vector<float> T(size_t(w) * h, 1.f);
+    std::vector<glm::vec3> C(size_t(w) * h, glm::vec3(0.f));
+    const PointFilterTable filter;
+    for (const auto& prims : windows) {
+        std::vector<size_t> order(prims.size());
+        std::iota(order.begin(), order.end(), 0);
+        std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+            const Primitive &p = prims[a], &q = prims[b];
+            const int kp = p.kind == PrimitiveKind::Point ? 0 : 1, kq = q.kind == PrimitiveKind::Point ? 0 : 1;
+            return std::tie(p.slab, kp, p.depth) < std::tie(q.slab, kq, q.depth);
+        });
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const size_t pix = size_t(y) * w + x;
+                float slabTau = 0.f;
+                glm::vec3 slabEmission(0.f);
+                int64_t slabOf = INT64_MIN;
+                const auto flush = [&] {
+                    if (slabTau > 0.f) {
+                        const float a = opacityFromOpticalDepth(slabTau);
+                        C[pix] += T[pix] * a * (slabEmission / slabTau);
+                        T[pix] *= 1.f - a;
+                    }
+                    slabTau = 0.f, slabEmission = glm::vec3(0.f);
+                };
+                for (size_t k : order) {
+                    const Primitive& p = prims[k];
+                    if (p.kind == PrimitiveKind::Culled) continue;
+                    if (p.slab != slabOf || p.kind != PrimitiveKind::Point) flush(), slabOf = p.slab;
+                    if (T[pix] < kTransmittanceEpsilon) continue;
+                    if (p.kind == PrimitiveKind::Point) {
+                        const PointFootprint fp = rasterizePoint(filter, PixelCoord(p.centre), p.variance);
+                        if (x < fp.x0 || x >= fp.x0 + fp.nx || y < fp.y0 || y >= fp.y0 + fp.ny) continue;
+                        const float tau = p.total * fp.at(x - fp.x0, y - fp.y0);
+                        slabTau += tau, slabEmission += tau * p.color;
+                    } else {
+                        if (x < p.range.x0 || x > p.range.x1 || y < p.range.y0 || y > p.range.y1) continue;
+                        const float dx = float(x) + 0.5f - p.centre.x, dy = float(y) + 0.5f - p.centre.y;
+                        const float i2 = p.conic.x * dx * dx + 2.f * p.conic.y * dx * dy + p.conic.z * dy * dy;
+                        if (!(i2 < 1.f)) continue;
+                        SplatShader shader;
+                        shader.row = tables().reindex.row(p.alpha);
+                        shader.footprint = &tables().footprint;
+                        shader.scale = p.scale;
+                        const float tau = p.kind == PrimitiveKind::SplatExactIndex
+                                              ? shader.depositAtD2(p.exactMap.d2(dx, dy)) : shader.depositAtIndex2(i2);
+                        const float a = opacityFromOpticalDepth(tau);
+                        C[pix] += T[pix] * a * p.color;
+                        T[pix] *= 1.f - a;
+                    }
+                }
+                flush();
+            }
+    }
+    for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = glm::vec4(C[i], 1.f - T[i]);
+    return image;
+}
+
+/// Random voxels in two depth windows, projected with a hybrid context (points and splats),
+/// dense enough that tiles go opaque (early termination is exercised too).
+std::vector<std::vector<Primitive>> randomWindows(const Camera& camera, RenderMode mode) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    // h = 0.1: voxels at depth 20–36 project to 0.4–0.7 px (points), the near seventh to 1.3–2.2 px (splats).
+    const ProjectionContext ctx{camera, tables(), 0.1, 0.1, mode, 1.0, FootprintPath::Auto, false};
+    std::vector<std::vector<Primitive>> windows(2);
+    for (int w = 0; w < 2; ++w)
+        for (int i = 0; i < 3000; ++i) {
+            const double depth = 20.0 + 8.0 * w + 8.0 * u(rng);
+            const glm::dvec3 c((u(rng) - 0.5) * 0.5 * depth, (u(rng) - 0.5) * 0.5 * depth, depth * (w == 0 && i % 7 == 0 ? 0.3 : 1.0));
+            Primitive p = projectVoxel(c, float(5.0 + 60.0 * u(rng)), glm::vec3(u(rng), u(rng), u(rng)), ctx);
+            p.depth = float(glm::length(c));
+            p.slab = int64_t(std::floor(p.depth / ctx.slabLength));
+            windows[size_t(w)].push_back(p);
+        }
+    return windows;
+}
+
+Image fastComposite(const std::vector<std::vector<Primitive>>& windows, const Camera& camera, bool vector) {
+    TileCompositor compositor(camera.width(), camera.height(), tables(), ExactContext{&camera, 0.1, vector});
+    double bin = 0.0, comp = 0.0;
+    for (const auto& prims : windows) compositor.composite(prims, bin, comp);
+    return compositor.image();
+}
+
+double maxDifference(const Image& a, const Image& b) {
+    double worst = 0.0;
+    for (size_t i = 0; i < a.pixels.size(); ++i)
+        for (int c = 0; c < 4; ++c) worst = std::max(worst, double(std::abs(a.pixels[i][c] - b.pixels[i][c])));
+    return worst;
+}
+
+TEST(TileCompositor, MatchesTheSlowPerPixelCompositor) {
+    const Camera camera = testCamera(72);  // 72 = 4.5 tiles: partial tiles at the edges
+    for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Point, RenderMode::Splat}) {
+        const auto windows = randomWindows(camera, mode);
+        int points = 0, splats = 0;
+        for (const auto& w : windows)
+            for (const Primitive& p : w) (p.kind == PrimitiveKind::Point ? points : splats) += p.kind != PrimitiveKind::Culled;
+        const Image slow = slowComposite(windows, camera.width(), camera.height());
+        const Image scalar = fastComposite(windows, camera, false), vector = fastComposite(windows, camera, true);
+        double opaque = 0.0;
+        for (const auto& px : slow.pixels) opaque += px.w > 0.999f;
+        std::printf("  %s: %d points, %d splats, %.0f%% of pixels opaque; scalar %.2g, vector %.2g\n",
+                    toString(mode).c_str(), points, splats, 100.0 * opaque / slow.pixels.size(),
+                    maxDifference(scalar, slow), maxDifference(vector, slow));
+        EXPECT_GT(opaque, 0.05 * slow.pixels.size()) << toString(mode);
+        EXPECT_LT(maxDifference(scalar, slow), 1e-5) << toString(mode);  // same arithmetic, other order of sums
+        // + the polynomial footprint: within 2e−5·F(0) of the tables (FootprintPoly.AgreesWithTheTablePath),
+        // times σ up to 65 per voxel length here, through α and T.
+        EXPECT_LT(maxDifference(vector, slow), 1e-4) << toString(mode);
+    }
+}
+
+// The compositor's image is the same, bit for bit, whatever the thread count.
+TEST(TileCompositor, SameImageForAnyThreadCount) {
+    const Camera camera = testCamera(72);
+    const auto windows = randomWindows(camera, RenderMode::Hybrid);
+    Image one, two;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = fastComposite(windows, camera, true);
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        two = fastComposite(windows, camera, true);
+    }
+    ASSERT_EQ(one.pixels, two.pixels);
+}
+
+// projectBatch is projectVoxel over the batch, in order, with the window's slab and depth.
+TEST(ProjectBatch, EqualsProjectVoxelOneByOne) {
+    const Camera camera = testCamera(64);
+    // h = 0.1: projected spacing 3 px at z = 4, 0.27 px at z = 44: points and splats.
+    const ProjectionContext ctx{camera, tables(), 0.1, 0.1, RenderMode::Hybrid, 1.0, FootprintPath::Auto, false};
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    VoxelBatch batch;
+    for (int i = 0; i < 5000; ++i) {
+        const float z = 4.f + 40.f * u(rng);
+        batch.viewPos.emplace_back((u(rng) - 0.5f) * z, (u(rng) - 0.5f) * z, z);
+        batch.distance.push_back(glm::length(batch.viewPos.back()));
+        batch.sigma.push_back(u(rng));
+        batch.color.emplace_back(u(rng), u(rng), u(rng));
+        batch.spread.push_back(i % 3 == 0 ? u(rng) : 0.f);
+        batch.members.push_back(1 + uint32_t(i % 5));
+    }
+    batch.slabBegin = 0, batch.slabEnd = 200;
+    std::vector<Primitive> buffer(7000);  // larger than the batch: only the first 5000 are this window
+    const std::span<const Primitive> prims = projectBatch(batch, ctx, buffer);
+    ASSERT_EQ(prims.size(), batch.size());
+    int kinds[6] = {};
+    for (size_t i = 0; i < batch.size(); ++i) {
+        const Primitive q = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
+        const Primitive& p = prims[i];
+        ++kinds[int(p.kind)];
+        ASSERT_EQ(p.kind, q.kind) << i;
+        ASSERT_EQ(p.centre, q.centre) << i;
+        ASSERT_EQ(p.variance, q.variance) << i;
+        ASSERT_EQ(p.total, q.total) << i;
+        ASSERT_EQ(p.conic, q.conic) << i;
+        ASSERT_EQ(p.scale, q.scale) << i;
+        ASSERT_EQ(p.members, batch.members[i]) << i;
+        ASSERT_EQ(p.depth, batch.distance[i]) << i;
+        ASSERT_EQ(p.slab, std::clamp<int64_t>(int64_t(std::floor(batch.distance[i] / ctx.slabLength)), 0, 199)) << i;
+    }
+    EXPECT_GT(kinds[int(PrimitiveKind::Point)], 100);
+    EXPECT_GT(kinds[int(PrimitiveKind::Splat)] + kinds[int(PrimitiveKind::SplatExactIndex)], 100);
+}
+
+}  // namespace
+}  // namespace vdbsplat
