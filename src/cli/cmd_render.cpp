@@ -7,14 +7,15 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <set>
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/render_flags.h"
 #include "image/image.h"
 #include "render/render.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
-#include "util/parse.h"
 
 namespace vdbsplat::cli {
 
@@ -54,50 +55,6 @@ const char* kHelp =
     "  --stats FILE.json  write settings, timings and primitive counts as JSON\n"
     "  -v                 print the statistics in one line\n";
 
-glm::dvec3 parseVec3(const std::string& text, const std::string& flag) {
-    const auto v = parseDoubleList(text, flag, 3);
-    return {v[0], v[1], v[2]};
-}
-
-RenderSettings settingsFrom(const Args& args) {
-    RenderSettings s;
-    if (auto v = args.get("--mode")) s.mode = parseRenderMode(*v);
-    if (auto v = args.get("--size")) parseSize(*v, "--size", 16384, s.camera.width, s.camera.height);
-    if (auto v = args.get("--tf")) s.transferFunction = *v;
-    if (auto v = args.get("--grid")) s.gridName = *v;
-    if (auto v = args.get("--fov")) s.camera.fovDeg = parseDouble(*v, "--fov");
-    if (auto v = args.get("--distance")) s.camera.distance = parseDouble(*v, "--distance");
-    if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
-    if (auto v = args.get("--max-voxels"))
-        s.maxActiveVoxels = uint64_t(parseInt(*v, "--max-voxels", 1, (long long)kHardMaxActiveVoxels));
-    if (auto v = args.get("--spp")) s.spp = int(parseInt(*v, "--spp", 1, 1024));
-    if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
-    if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
-    if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
-    if (auto v = args.get("--simd")) {
-        if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
-        s.simd = *v == "on";
-    }
-    s.showPrimitives = args.has("--show-primitives");
-    if (auto v = args.get("--tables")) {
-        if (v->empty()) throw Error("--tables: expected a directory, got ''");
-        s.tablesDir = *v;
-    }
-    if (args.has("--look-at") && !args.has("--eye")) throw Error("--look-at: needs --eye");
-    if (args.has("--view-dir") && args.has("--eye")) throw Error("--view-dir: not with --eye (it sets the framing direction)");
-    if (auto u = args.get("--up")) s.camera.up = parseVec3(*u, "--up");
-    if (auto v = args.get("--view-dir")) {
-        s.camera.hasViewDir = true;
-        s.camera.viewDir = parseVec3(*v, "--view-dir");
-    }
-    if (auto v = args.get("--eye")) {
-        s.camera.hasEye = true;
-        s.camera.eye = parseVec3(*v, "--eye");
-    }
-    s.validate();
-    return s;
-}
-
 /// The stats file is written after the image: check its folder first, so a bad --stats
 /// path fails before any work and never leaves an image behind.
 void checkStatsPath(const std::string& path, const std::string& image) {
@@ -129,17 +86,16 @@ std::string oneLine(const RenderStats& st, const RenderSettings& s) {
 }  // namespace
 
 int runRender(const Argv& argv) {
-    const Args args(argv,
-                    {"-o", "--grid", "--mode", "--size", "--tf", "--eye", "--look-at", "--up", "--view-dir", "--fov", "--distance",
-                     "--threads", "--spp", "--stats", "--max-voxels", "--threshold", "--lod", "--simd", "--footprint", "--tables"},
-                    {"-v", "--show-primitives"});
+    std::set<std::string> valueFlags = renderValueFlags();
+    valueFlags.insert({"-o", "--stats"});
+    const Args args(argv, valueFlags, {"-v", "--show-primitives"});
     if (args.wantsHelp()) {
         std::cout << kHelp;
         return 0;
     }
     const std::string input = args.onePositional("input .vdb file");
     const std::string output = args.require("-o");
-    RenderSettings settings = settingsFrom(args);
+    RenderSettings settings = settingsFromFlags(args);
     checkImagePath(output);
     const auto statsPath = args.get("--stats");
     if (statsPath) checkStatsPath(*statsPath, output);
@@ -148,24 +104,10 @@ int runRender(const Argv& argv) {
     if (settings.threads > 0)
         threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
 
-    const TransferFunction tf = [&] {
-        try {
-            return TransferFunction::fromSpec(settings.transferFunction);
-        } catch (const Error& e) {
-            throw Error(std::string("--tf: ") + e.what());
-        }
-    }();
+    const TransferFunction tf = transferFunctionFor(settings);
     const Volume volume = loadVolume(input, settings.gridName);
     checkVoxelBudget(volume, settings);
-    if (auto v = args.get("--eye")) {
-        if (auto l = args.get("--look-at")) {
-            settings.camera.lookAt = parseVec3(*l, "--look-at");
-        } else {
-            glm::dvec3 lo, hi;
-            volume.worldBounds(lo, hi);
-            settings.camera.lookAt = 0.5 * (lo + hi);
-        }
-    }
+    resolveLookAt(args, volume, settings);
     const Camera camera = cameraFor(volume, settings);  // validates eye/look-at/up before the work
 
     RenderStats stats;

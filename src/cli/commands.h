@@ -17,5 +17,6 @@ int runRender(const Argv& args);    ///< vdbsplat render FILE.vdb -o OUT.png|exr
 int runTables(const Argv& args);    ///< vdbsplat tables --out DIR | --check
 int runBench(const Argv& args);     ///< vdbsplat bench FILE.vdb …
 int runCompare(const Argv& args);   ///< vdbsplat compare A B (PSNR, …)
+int runAnimate(const Argv& args);   ///< vdbsplat animate FILE.vdb -o DIR (zoom, orbit or keyframes)
 
 }  // namespace vdbsplat::cli

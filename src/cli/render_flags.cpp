@@ -1,0 +1,80 @@
+// cli/render_flags.cpp — render flags → RenderSettings (see render_flags.h).
+#include "cli/render_flags.h"
+
+#include "util/error.h"
+#include "util/parse.h"
+
+namespace vdbsplat::cli {
+
+const std::set<std::string>& renderValueFlags() {
+    static const std::set<std::string> flags{"--grid",   "--mode",      "--size",      "--tf",    "--eye",
+                                             "--look-at", "--up",       "--view-dir",  "--fov",   "--distance",
+                                             "--threads", "--spp",      "--threshold", "--lod",   "--footprint",
+                                             "--tables",  "--simd", "--max-voxels"};
+    return flags;
+}
+
+glm::dvec3 parseVec3(const std::string& text, const std::string& flag) {
+    const auto v = parseDoubleList(text, flag, 3);
+    return {v[0], v[1], v[2]};
+}
+
+RenderSettings settingsFromFlags(const Args& args) {
+    RenderSettings s;
+    if (auto v = args.get("--mode")) s.mode = parseRenderMode(*v);
+    if (auto v = args.get("--size")) parseSize(*v, "--size", 16384, s.camera.width, s.camera.height);
+    if (auto v = args.get("--tf")) s.transferFunction = *v;
+    if (auto v = args.get("--grid")) s.gridName = *v;
+    if (auto v = args.get("--fov")) s.camera.fovDeg = parseDouble(*v, "--fov");
+    if (auto v = args.get("--distance")) s.camera.distance = parseDouble(*v, "--distance");
+    if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
+    if (auto v = args.get("--spp")) s.spp = int(parseInt(*v, "--spp", 1, 1024));
+    if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
+    if (auto v = args.get("--max-voxels"))
+        s.maxActiveVoxels = uint64_t(parseInt(*v, "--max-voxels", 1, (long long)kHardMaxActiveVoxels));
+    if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
+    if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
+    if (auto v = args.get("--simd")) {
+        if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
+        s.simd = *v == "on";
+    }
+    s.showPrimitives = args.has("--show-primitives");
+    if (auto v = args.get("--tables")) {
+        if (v->empty()) throw Error("--tables: expected a directory, got ''");
+        s.tablesDir = *v;
+    }
+    if (args.has("--look-at") && !args.has("--eye")) throw Error("--look-at: needs --eye");
+    if (args.has("--view-dir") && args.has("--eye")) throw Error("--view-dir: not with --eye (it sets the framing direction)");
+    if (auto u = args.get("--up")) s.camera.up = parseVec3(*u, "--up");
+    if (auto v = args.get("--view-dir")) {
+        s.camera.hasViewDir = true;
+        s.camera.viewDir = parseVec3(*v, "--view-dir");
+    }
+    if (auto v = args.get("--eye")) {
+        s.camera.hasEye = true;
+        s.camera.eye = parseVec3(*v, "--eye");
+    }
+    s.validate();
+    return s;
+}
+
+void resolveLookAt(const Args& args, const Volume& volume, RenderSettings& settings) {
+    if (!args.get("--eye")) return;
+    if (auto l = args.get("--look-at")) {
+        settings.camera.lookAt = parseVec3(*l, "--look-at");
+    } else {
+        glm::dvec3 lo, hi;
+        volume.worldBounds(lo, hi);
+        settings.camera.lookAt = 0.5 * (lo + hi);
+    }
+}
+
+TransferFunction transferFunctionFor(const RenderSettings& settings) {
+    try {
+        return TransferFunction::fromSpec(settings.transferFunction);
+    } catch (const Error& e) {
+        throw Error(std::string("--tf: ") + e.what());
+    }
+}
+
+}  // namespace vdbsplat::cli

@@ -1,0 +1,35 @@
+// cli/render_flags.h — the render flags shared by `vdbsplat render` and `vdbsplat animate`.
+// Owns: turning --mode, --size, --tf, --grid, --fov, --distance, --threads, --spp,
+// --threshold, --footprint, --lod, --simd, --show-primitives, --tables, --up, --view-dir, --eye and
+// --look-at into validated RenderSettings, the same way for every command that renders
+// (a command that does not declare a flag never sees it: Args refuses it first).
+#pragma once
+#include <glm/glm.hpp>
+#include <set>
+#include <string>
+
+#include "cli/args.h"
+#include "render/settings.h"
+#include "volume/grid.h"
+#include "volume/transfer_function.h"
+
+namespace vdbsplat::cli {
+
+/// The value flags settingsFromFlags() reads (without -o and command-specific ones).
+const std::set<std::string>& renderValueFlags();
+
+/// @brief "X,Y,Z" → vector; @throw Error naming @p flag.
+glm::dvec3 parseVec3(const std::string& text, const std::string& flag);
+
+/// @brief The validated settings the render flags in @p args describe (defaults elsewhere).
+/// --eye's look-at is resolved after the volume is loaded (resolveLookAt).
+/// @throw Error naming the first bad flag.
+RenderSettings settingsFromFlags(const Args& args);
+
+/// @brief With --eye: the look-at from --look-at, or the centre of @p volume's bounds.
+void resolveLookAt(const Args& args, const Volume& volume, RenderSettings& settings);
+
+/// @brief The transfer function of settings.transferFunction; @throw Error "--tf: …".
+TransferFunction transferFunctionFor(const RenderSettings& settings);
+
+}  // namespace vdbsplat::cli
