@@ -156,6 +156,30 @@ Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label) {
     return v;
 }
 
+namespace {
+/// Prefix of the child's message when its read succeeded but the hand-over failed.
+constexpr const char* kHandOverFailed = "[hand-over] ";
+
+/// The fallback when the memfd hand-over fails (RLIMIT_FSIZE applies to memfds): a plain read
+/// here, after the child has shown that OpenVDB reads this file without crashing.
+Volume loadDirectly(const std::string& path, const std::string& gridName) {
+    OpenVdbLogCapture log;
+    const openvdb::GridBase::Ptr base = readGridToRender(path, gridName);
+    log.keep();
+    openvdb::FloatGrid::Ptr grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+    if (!grid) {
+        const auto d = openvdb::gridPtrCast<openvdb::DoubleGrid>(base);
+        grid = openvdb::FloatGrid::create(std::make_shared<openvdb::FloatTree>(d->tree()));  // value-converting copy
+        grid->setTransform(d->transform().copy());
+        grid->setName(d->getName());
+        grid->setGridClass(d->getGridClass());
+    }
+    Volume v = makeVolume(grid, path);
+    v.file = path;
+    return v;
+}
+}  // namespace
+
 // The grid is read once, in a forked child (OpenVDB's reader can crash on damaged data:
 // there that is a one-line Error here), which hands it over as a float tree through a
 // memfd (volume/grid_transfer.h); the parent allocates the leaves meanwhile, then rebuilds
@@ -169,7 +193,11 @@ Volume loadVolume(const std::string& path, const std::string& gridName) {
         const openvdb::GridBase::Ptr base = readGridToRender(path, gridName, hint);
         double voxelSize = 0.0;  // refuse what the parent would refuse, before handing it over
         linearUniformMap(base->transform(), gridLabel(path, base->getName()), voxelSize);
-        encodeGridTransfer(*base, log.held(), transfer.fd(), path);
+        try {
+            encodeGridTransfer(*base, log.held(), transfer.fd(), path);
+        } catch (const Error& e) {  // the read worked; only the hand-over did not (e.g. ulimit -f)
+            throw Error(kHandOverFailed + std::string(e.what()));
+        }
     });
     // While the child reads, allocate the leaves it estimates (their page faults are most of
     // what building a tree costs), at most one per 64 bytes of file: each leaf's value mask
@@ -179,7 +207,12 @@ Volume loadVolume(const std::string& path, const std::string& gridName) {
         const uint64_t fileBytes = std::filesystem::file_size(path, ec);
         transfer.preallocate(std::min(*leaves, ec ? 0 : fileBytes / 64));
     }
-    child.succeeded();
+    try {
+        child.succeeded();
+    } catch (const Error& e) {
+        if (std::string(e.what()).rfind(kHandOverFailed, 0) != 0) throw;
+        return loadDirectly(path, gridName);  // the child read this file without crashing: safe here
+    }
     DecodedGrid decoded = transfer.decode();
     if (!decoded.log.empty()) std::cerr << decoded.log;
     Volume v = wrapGrid(std::move(decoded.grid), path, decoded.activeVoxels);
