@@ -67,12 +67,10 @@ struct CliResult {
 /// stderr go through files in @p logDir. @p timeoutSeconds > 0 kills it after that long
 /// (rc 124: a bound on time, never a timed assertion); @p shellPrefix runs first in the
 /// same shell (e.g. "ulimit -f 8; ").
-inline CliResult runVdbsplat(const std::string& args, const fs::path& logDir, int timeoutSeconds = 0,
-                             const std::string& shellPrefix = "") {
+/// Runs the shell command @p command with stdout and stderr captured through files in @p logDir.
+inline CliResult runShell(const std::string& command, const fs::path& logDir) {
     const fs::path out = logDir / "stdout.txt", err = logDir / "stderr.txt";
-    const std::string timeout = timeoutSeconds > 0 ? "timeout -k 5 " + std::to_string(timeoutSeconds) + " " : "";
-    const std::string cmd = shellPrefix + timeout + "'" + VDBSPLAT_BINARY + "' " + args + " >'" + out.string() +
-                            "' 2>'" + err.string() + "'";
+    const std::string cmd = command + " >'" + out.string() + "' 2>'" + err.string() + "'";
     const int status = std::system(cmd.c_str());
     CliResult r;
     r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -81,6 +79,12 @@ inline CliResult runVdbsplat(const std::string& args, const fs::path& logDir, in
     fs::remove(out);
     fs::remove(err);
     return r;
+}
+
+inline CliResult runVdbsplat(const std::string& args, const fs::path& logDir, int timeoutSeconds = 0,
+                             const std::string& shellPrefix = "") {
+    const std::string timeout = timeoutSeconds > 0 ? "timeout -k 5 " + std::to_string(timeoutSeconds) + " " : "";
+    return runShell(shellPrefix + timeout + "'" + VDBSPLAT_BINARY + "' " + args, logDir);
 }
 
 /// @brief The error contract: non-zero exit, exactly one stderr line "vdbsplat: error: …"

@@ -37,17 +37,8 @@ std::string quote(const std::string& s) { return "'" + s + "'"; }
 /// @brief Runs `bash volumes/SCRIPT ARGS` (ARGS quoted by the caller) with the test's binary
 /// as $VDBSPLAT; stdout and stderr go through files in @p logDir.
 CliResult runScript(const std::string& script, const std::string& args, const fs::path& logDir) {
-    const fs::path out = logDir / "stdout.txt", err = logDir / "stderr.txt";
-    const std::string cmd = "VDBSPLAT=" + quote(VDBSPLAT_BINARY) + " bash " + quote(kSource + "/volumes/" + script) +
-                            " " + args + " >" + quote(out.string()) + " 2>" + quote(err.string());
-    const int status = std::system(cmd.c_str());
-    CliResult r;
-    r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(out);
-    r.err = slurp(err);
-    fs::remove(out);
-    fs::remove(err);
-    return r;
+    return vdbsplat::test::runShell("VDBSPLAT=" + quote(VDBSPLAT_BINARY) + " bash " + quote(kSource + "/volumes/" + script) + " " + args,
+                          logDir);
 }
 
 /// @brief The script's error contract: exit 1, exactly one stderr line "fetch: error: …"
