@@ -1,6 +1,7 @@
 // volume/grid.cpp — loading and validating sparse grids (see grid.h).
 #include "volume/grid.h"
 
+#include <openvdb/io/DelayedLoadMetadata.h>
 #include <openvdb/io/File.h>
 
 #include <cmath>
@@ -111,7 +112,14 @@ void sanitizeValues(Volume& v) {
 
 void initOpenVdb() {
     static std::once_flag once;
-    std::call_once(once, [] { openvdb::initialize(); });
+    std::call_once(once, [] {
+        openvdb::initialize();
+        // vdbsplat never delay-loads, and DelayedLoadMetadata::readValue sizes its arrays from
+        // counts inside the value, not from the size the file declares (a damaged count
+        // allocates gigabytes). Unregistered, "__delayedload" items are read as unknown
+        // metadata of their declared size, which checkVdbStructure bounds by the file.
+        openvdb::Metadata::unregisterType(openvdb::io::DelayedLoadMetadata::staticTypeName());
+    });
 }
 
 void Volume::worldBounds(glm::dvec3& lo, glm::dvec3& hi) const {

@@ -18,13 +18,17 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <utility>
 
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <openvdb/Metadata.h>
+
 #include "util/error.h"
+#include "volume/grid.h"
 
 namespace vdbsplat {
 
@@ -91,14 +95,33 @@ private:
     std::string path_;
 };
 
-/// A metadata block (the file's or a grid's): every item within the reader's limit.
+/// Bytes OpenVDB's reader consumes for a metadata value of @p type: a registered fixed-size
+/// type (TypedMetadata<T>, Metadata.h) reads sizeof(T) whatever size the file declares, so
+/// the check must walk the same bytes or it goes out of step with the reader (a fuzzed
+/// `int64` item declaring 9 bytes made OpenVDB take a string length from the wrong place:
+/// 5 GB allocated for a 5.6 KB file). std::nullopt: the declared size is what is read
+/// ("string" and unregistered types, read as UnknownMetadata).
+std::optional<uint64_t> fixedMetadataBytes(const std::string& type) {
+    if (type == "string" || type.empty() || !openvdb::Metadata::isRegisteredType(type)) return std::nullopt;
+    try {
+        return openvdb::Metadata::createMetadata(type)->size();
+    } catch (const std::exception&) {
+        return std::nullopt;
+    }
+}
+
+/// A metadata block (the file's or a grid's): every item within the reader's limit, each
+/// fixed-size value declaring exactly the size OpenVDB reads.
 void skipMetadata(Reader& r, uint64_t end) {
     const int32_t count = r.value<int32_t>("metadata count");
     if (count < 0 || uint64_t(count) > (end - std::min(end, r.pos())) / 12) r.corrupt("metadata count");
     for (int32_t i = 0; i < count; ++i) {
         r.skipString("metadata name");
-        r.skipString("metadata type");
-        r.skipString("metadata value");  // uint32 size + bytes, like a string
+        const std::string type = r.string("metadata type");
+        const uint32_t declared = r.value<uint32_t>("metadata value size");
+        const std::optional<uint64_t> fixed = fixedMetadataBytes(type);
+        if (fixed && *fixed != declared) r.corrupt("metadata value size");
+        r.skip(declared, "metadata value");
     }
 }
 
@@ -136,6 +159,33 @@ void checkGridHeader(Reader& r, uint32_t version, const std::string& gridType, u
     r.limit(r.size());  // the caller goes on forward, to the grid's end (≥ blockPos)
 }
 
+/// Files without grid offsets (written by io::Stream) hold each grid right after its
+/// descriptor, and OpenVDB reads them in sequence. Only the first grid's start is known
+/// without parsing its tree; later ones are checked where the descriptor's offsets are
+/// consistent (files written by io::File with the flag cleared), otherwise refused.
+void checkSequentialGrids(Reader& r, uint32_t version) {
+    const int32_t grids = r.value<int32_t>("grid count");
+    if (grids < 0 || uint64_t(grids) > (r.size() - r.pos()) / 32) r.corrupt("grid count");
+    for (int32_t i = 0; i < grids; ++i) {
+        r.skipString("grid name");
+        const std::string type = r.string("grid type");
+        if (version >= kInstancingVersion) r.skipString("grid instance parent");
+        const int64_t gridPos = r.value<int64_t>("grid offset");
+        const int64_t blockPos = r.value<int64_t>("grid data offset");
+        const int64_t endPos = r.value<int64_t>("grid end offset");
+        const bool consistent = gridPos == int64_t(r.pos()) && blockPos >= gridPos && endPos >= blockPos &&
+                                uint64_t(endPos) <= r.size();
+        if (consistent) {
+            checkGridHeader(r, version, type, uint64_t(gridPos), uint64_t(blockPos));
+            r.seek(uint64_t(endPos), "grid end offset");
+        } else if (grids == 1) {
+            checkGridHeader(r, version, type, r.pos(), r.size());
+        } else {
+            r.corrupt("grid without offsets in a file of several grids (not supported)");
+        }
+    }
+}
+
 void checkGridDescriptors(Reader& r, uint32_t version) {
     const int32_t grids = r.value<int32_t>("grid count");
     if (grids < 0 || uint64_t(grids) > (r.size() - r.pos()) / 32) r.corrupt("grid count");
@@ -166,6 +216,7 @@ uint64_t vdbMapBytes(const std::string& type) {
 }
 
 void checkVdbStructure(const std::string& path) {
+    initOpenVdb();  // the metadata type registry (fixedMetadataBytes)
     std::error_code ec;
     const uint64_t size = std::filesystem::file_size(path, ec);
     if (ec) throw Error(path + ": cannot read (" + ec.message() + ")");
@@ -179,7 +230,10 @@ void checkVdbStructure(const std::string& path) {
     const char hasOffsets = r.value<char>("grid offsets flag");
     r.skip(36, "file UUID");
     skipMetadata(r, size);
-    if (hasOffsets) checkGridDescriptors(r, version);
+    if (hasOffsets)
+        checkGridDescriptors(r, version);
+    else
+        checkSequentialGrids(r, version);
 }
 
 void openVdbFile(openvdb::io::File& file, const std::string& path) {

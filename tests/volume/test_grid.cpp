@@ -11,6 +11,7 @@
 #include <openvdb/io/File.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -200,6 +201,45 @@ TEST_F(Grid, CorruptedBytesGiveOneErrorAndNoLogLines) {
         }
     }
     EXPECT_GT(failed, 50);  // the corruptions do reach the reader
+}
+
+// Found by fuzzing (CI, fuzz_vdb timeout): OpenVDB reads a fixed-size metadata value
+// (int64, vec3i, …) as sizeof(T) whatever size the file declares, so a declared size one
+// too large put the pre-check and the reader out of step; the reader then took a string
+// length from the wrong bytes (5 GB allocated, 18 s, for a 5.6 KB file). A file without grid
+// offsets (io::Stream layout: the grid follows its descriptor) skipped the grid check
+// entirely. Both are refused now; the same files with their sizes intact still load.
+TEST_F(Grid, MetadataSizesMustMatchWhatOpenVdbReads) {
+    auto grid = smallGrid();
+    grid->insertMeta("frames", openvdb::Int64Metadata(7));
+    const std::string good = write("meta.vdb", {grid});
+    std::ifstream in(good, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // "frames" is the grid's first metadata item: name, type "int64", uint32 size 8, value.
+    const std::string item = std::string("\x06\0\0\0frames\x05\0\0\0int64\x08\0\0\0", 23);
+    const size_t at = bytes.find(item);
+    ASSERT_NE(at, std::string::npos);
+    constexpr size_t kOffsetsFlag = 20;  // magic 8, version 4, library 4 + 4
+    ASSERT_EQ(bytes[kOffsetsFlag], 1);
+    const auto variant = [&](const std::string& name, bool offsets, uint32_t declared) {
+        std::string b = bytes;
+        b[kOffsetsFlag] = char(offsets);
+        std::memcpy(b.data() + at + item.size() - 4, &declared, 4);
+        std::ofstream(path(name), std::ios::binary).write(b.data(), std::streamsize(b.size()));
+        return path(name);
+    };
+    for (const bool offsets : {true, false}) {
+        const std::string ok = variant("ok.vdb", offsets, 8);
+        EXPECT_EQ(loadVolume(ok).activeVoxels, grid->activeVoxelCount()) << "offsets " << offsets;
+        EXPECT_NO_THROW(describeFile(ok)) << "offsets " << offsets;
+        for (const uint32_t declared : {9u, 7u, 1000u}) {
+            const std::string bad = variant("bad.vdb", offsets, declared);
+            const std::string message = errorOf([&] { checkVdbStructure(bad); });
+            EXPECT_TRUE(has(message, bad + ": truncated or corrupt VDB file (metadata value size"))
+                << "offsets " << offsets << ", size " << declared << ": " << message;
+            EXPECT_TRUE(has(errorOf([&] { loadVolume(bad); }), bad)) << "offsets " << offsets;
+        }
+    }
 }
 
 // The child-process read turns an OpenVDB crash into an Error (fuzzing found a flipped byte
