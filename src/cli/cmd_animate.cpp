@@ -33,6 +33,7 @@
 #include "animation/frame_stats.h"
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/interrupt.h"
 #include "cli/render_flags.h"
 #include "image/image.h"
 #include "metrics/metrics.h"
@@ -103,38 +104,6 @@ const char* kHelp =
     "\n"
     "Ctrl-C or SIGTERM stops after the frame being rendered (a second one stops at once):\n"
     "finished frames and frames.csv stay consistent, exit 1. Prints a summary line on stdout.\n";
-
-// ---- interruption: a flag set by the signal handler, checked between frames -------------
-
-std::atomic<int> gSignal{0};
-
-extern "C" void onSignal(int sig) { gSignal.store(sig); }
-
-/// Installs the handler for SIGINT and SIGTERM (one-shot: a second signal takes the default
-/// action) and restores the previous handlers on destruction.
-class InterruptGuard {
-public:
-    InterruptGuard() {
-        gSignal.store(0);
-        struct sigaction sa{};
-        sa.sa_handler = onSignal;
-        sigemptyset(&sa.sa_mask);
-        sa.sa_flags = SA_RESETHAND;
-        // A signal ignored when we start (SIGINT of a background job in a script) stays ignored.
-        sigaction(SIGINT, nullptr, &oldInt_);
-        sigaction(SIGTERM, nullptr, &oldTerm_);
-        if (oldInt_.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, nullptr);
-        if (oldTerm_.sa_handler != SIG_IGN) sigaction(SIGTERM, &sa, nullptr);
-    }
-    ~InterruptGuard() {
-        sigaction(SIGINT, &oldInt_, nullptr);
-        sigaction(SIGTERM, &oldTerm_, nullptr);
-    }
-    bool interrupted() const { return gSignal.load() != 0; }
-
-private:
-    struct sigaction oldInt_{}, oldTerm_{};
-};
 
 // ---- the path -----------------------------------------------------------------------------
 
@@ -340,14 +309,6 @@ std::string frameName(size_t i, size_t count, const std::string& ext) {
     const int digits = std::max<int>(4, int(std::to_string(count > 0 ? count - 1 : 0).size()));
     char buf[64];
     std::snprintf(buf, sizeof buf, "frame_%0*zu.%s", digits, i, ext.c_str());
-    return buf;
-}
-
-std::string durationText(double s) {
-    char buf[32];
-    if (s < 60) std::snprintf(buf, sizeof buf, "%.0fs", s);
-    else if (s < 3600) std::snprintf(buf, sizeof buf, "%dm%02ds", int(s) / 60, int(s) % 60);
-    else std::snprintf(buf, sizeof buf, "%dh%02dm", int(s) / 3600, (int(s) / 60) % 60);
     return buf;
 }
 

@@ -11,6 +11,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/interrupt.h"
 #include "cli/render_flags.h"
 #include "image/image.h"
 #include "render/render.h"
@@ -53,7 +54,11 @@ const char* kHelp =
     "                     by voxel (default 2^30 = 1073741824, at most 2^32)\n"
     "  --threads N        worker threads (default: all cores); the image does not depend on it\n"
     "  --stats FILE.json  write settings, timings and primitive counts as JSON\n"
-    "  -v                 print the statistics in one line\n";
+    "  -v                 show progress on stderr (a bar with ETA on a terminal, a line per\n"
+    "                     10% otherwise) and print the statistics in one line at the end\n"
+    "\n"
+    "Ctrl-C or SIGTERM stops the render within a window (forward modes) or a row of rays\n"
+    "(reference): nothing is written, exit 1. A second one stops at once.\n";
 
 /// The stats file is written after the image: check its folder first, so a bad --stats
 /// path fails before any work and never leaves an image behind.
@@ -100,6 +105,7 @@ int runRender(const Argv& argv) {
     const auto statsPath = args.get("--stats");
     if (statsPath) checkStatsPath(*statsPath, output);
 
+    InterruptGuard guard;  // before loading: a Ctrl-C then stops the render before it starts
     std::unique_ptr<tbb::global_control> threads;
     if (settings.threads > 0)
         threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
@@ -111,7 +117,20 @@ int runRender(const Argv& argv) {
     const Camera camera = cameraFor(volume, settings);  // validates eye/look-at/up before the work
 
     RenderStats stats;
-    const Image image = render(volume, tf, settings, stats);
+    RenderControl control;
+    control.stop = [&guard] { return guard.interrupted(); };
+    std::unique_ptr<ProgressMeter> meter;
+    if (args.has("-v")) {
+        meter = std::make_unique<ProgressMeter>(toString(settings.mode));
+        control.progress = [&meter](double f) { meter->update(f); };
+    }
+    Image image;
+    try {
+        image = render(volume, tf, settings, stats, control);
+    } catch (const RenderStopped&) {
+        throw Error("render interrupted by " + guard.signalName() + "; " + output + " not written");
+    }
+    if (meter) meter->finish();
 
     nlohmann::json meta = settings.toJson();
     meta.update(stats.toJson());

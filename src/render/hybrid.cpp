@@ -17,7 +17,8 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 }  // namespace
 
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
-                    const Tables& tables, const RenderSettings& settings, RenderStats& stats) {
+                    const Tables& tables, const RenderSettings& settings, RenderStats& stats,
+                    const RenderControl& control) {
     StreamOptions streamOptions = settings.stream;
     streamOptions.lodCellPx = settings.lodPx;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point   ? INFINITY
@@ -32,6 +33,8 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     std::vector<Primitive> prims;
     uint64_t drawnVoxels = 0;
     while (true) {
+        if (control.stop && control.stop()) throw RenderStopped("render stopped");
+        if (control.progress) control.progress(stream.progress());
         auto t = Clock::now();
         if (!stream.next(batch, hidden)) break;
         stats.streamSeconds += since(t);

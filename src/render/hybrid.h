@@ -14,6 +14,7 @@ namespace vdbsplat {
 
 /// @brief Renders @p volume in settings.mode (Hybrid, Splat or Point).
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
-                    const Tables& tables, const RenderSettings& settings, RenderStats& stats);
+                    const Tables& tables, const RenderSettings& settings, RenderStats& stats,
+                    const RenderControl& control = {});
 
 }  // namespace vdbsplat

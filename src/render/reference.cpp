@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -320,7 +321,7 @@ double RayIntegrator::opticalDepth(const glm::dvec3& origin, const glm::dvec3& d
 }
 
 Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
-                      RenderStats& stats) {
+                      RenderStats& stats, const RenderControl& control) {
     const auto start = std::chrono::steady_clock::now();
     const int n = std::max(1, int(std::ceil(std::sqrt(double(spp)) - 1e-9)));  // strata per axis
     stats.raysPerPixel = n * n;
@@ -338,6 +339,10 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
     const ActiveRegions regions(*volume.grid);
     std::vector<glm::vec4> samples;
     const double cutoff2 = kPrefilterCutoffSigmas * kPrefilterCutoffSigmas * kPrefilterVariance;
+    const int bands = (H + bandRows - 1) / bandRows;
+    const double totalRows = double(H + bands * 2 * border);  // sample rows traced over all bands
+    std::atomic<int64_t> rowsDone{0};
+    std::atomic<bool> stopped{false};
 
     for (int y0 = 0; y0 < H; y0 += bandRows) {
         const int y1 = std::min(H, y0 + bandRows);
@@ -349,14 +354,21 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
         };
         tbb::parallel_for(tbb::blocked_range<int>(0, sh, 1), [&](const tbb::blocked_range<int>& rows) {
             RayIntegrator integrator(volume, table, &regions);
-            for (int r = rows.begin(); r < rows.end(); ++r)
+            for (int r = rows.begin(); r < rows.end(); ++r) {
+                if (stopped.load(std::memory_order_relaxed) || (control.stop && control.stop())) {
+                    stopped.store(true);
+                    return;
+                }
                 for (int c = 0; c < sw; ++c)
                     for (int s = 0; s < n * n; ++s) {
                         const PixelCoord q = samplePos(c - border, sy0 + r, s);
                         samples[(size_t(r) * sw + c) * n * n + s] =
                             glm::vec4(integrator.integrate(camera.eye(), camera.worldRay(q)));
                     }
+                if (control.progress) control.progress(double(rowsDone.fetch_add(1) + 1) / totalRows);
+            }
         });
+        if (stopped.load()) throw RenderStopped("render stopped");
         // Band-limit by the prefilter h_p and sample at pixel centres (DESIGN §1).
         tbb::parallel_for(tbb::blocked_range<int>(y0, y1, 1), [&](const tbb::blocked_range<int>& rows) {
             for (int y = rows.begin(); y < rows.end(); ++y)

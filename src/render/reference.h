@@ -86,7 +86,9 @@ private:
 /// deterministic hash of pixel and sample picks the jitter, so the image does not depend on
 /// the thread count), each pixel the prefilter-weighted mean of the samples within
 /// kPrefilterCutoffSigmas standard deviations of its centre.
+/// @param control progress (fraction of sample rows traced) and stop (polled per sample row).
+/// @throw RenderStopped when control.stop returned true.
 Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
-                      RenderStats& stats);
+                      RenderStats& stats, const RenderControl& control = {});
 
 }  // namespace vdbsplat

@@ -52,8 +52,10 @@ Camera cameraFor(const Volume& volume, const RenderSettings& settings) {
     return makeCamera(settings.camera, lo, hi);
 }
 
-Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings, RenderStats& stats) {
+Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings, RenderStats& stats,
+             const RenderControl& control) {
     const auto start = std::chrono::steady_clock::now();
+    if (control.stop && control.stop()) throw RenderStopped("render stopped before it began");
     checkVoxelBudget(volume, settings);
     float lo, hi;
     normalizationRange(volume, lo, hi);
@@ -62,17 +64,18 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     stats.activeVoxels = volume.activeVoxels;
     Image image;
     switch (settings.mode) {
-        case RenderMode::Reference: image = renderReference(volume, table, camera, settings.spp, stats); break;
+        case RenderMode::Reference: image = renderReference(volume, table, camera, settings.spp, stats, control); break;
         case RenderMode::Hybrid:
         case RenderMode::Splat:
         case RenderMode::Point: {
             const Tables tables =
                 loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir));
-            image = renderForward(volume, table, camera, tables, settings, stats);
+            image = renderForward(volume, table, camera, tables, settings, stats, control);
             break;
         }
     }
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (control.progress) control.progress(1.0);
     return image;
 }
 

@@ -28,6 +28,9 @@ Camera cameraFor(const Volume& volume, const RenderSettings& settings);
 /// @brief Renders @p volume with @p settings (already validated) and transfer function @p tf.
 /// Uses the calling thread's TBB arena (the caller limits threads with tbb::global_control).
 /// @throw Error for settings the mode cannot honour.
-Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings, RenderStats& stats);
+/// @param control optional progress report and stop request (Ctrl-C); see RenderControl.
+/// @throw RenderStopped when control.stop returned true.
+Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings, RenderStats& stats,
+             const RenderControl& control = {});
 
 }  // namespace vdbsplat

@@ -4,9 +4,11 @@
 // options-struct pattern) and RenderStats (what a render measured).
 #pragma once
 #include <nlohmann/json.hpp>
+#include <functional>
 #include <string>
 
 #include "camera/camera.h"
+#include "util/error.h"
 #include "volume/stream.h"
 
 namespace vdbsplat {
@@ -60,6 +62,22 @@ struct RenderSettings {
     /// @throw Error naming the flag of the first invalid value (--tables: DIR must be a directory).
     void validate() const;
     nlohmann::json toJson() const;
+};
+
+/// @brief How a long render reports progress and learns that it should stop (Ctrl-C).
+/// Both are optional and neither changes the image.
+struct RenderControl {
+    /// The fraction of the work done, in [0, 1]; called from rendering threads (thread-safe, cheap).
+    std::function<void(double)> progress;
+    /// Polled before the work, between depth windows (forward modes) and between rows
+    /// (reference); returning true makes render() throw RenderStopped.
+    std::function<bool()> stop;
+};
+
+/// @brief Thrown when RenderControl::stop asked the render to end early; nothing was drawn to keep.
+class RenderStopped : public Error {
+public:
+    using Error::Error;
 };
 
 struct RenderStats {

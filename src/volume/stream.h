@@ -86,6 +86,8 @@ public:
     uint64_t windows() const { return windows_; }        ///< windows released so far
     size_t largestWindow() const { return largest_; }    ///< most voxels in one window so far
     double slabLength() const { return slabLength_; }    ///< world length of one slab
+    /// Fraction of the visible blocks streamed so far (for progress reports).
+    double progress() const { return blocks_.empty() ? 1.0 : double(nextBlock_) / double(blocks_.size()); }
 
 private:
     struct Block {

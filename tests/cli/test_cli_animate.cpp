@@ -301,33 +301,14 @@ TEST_F(AnimateCli, BadInputOneLineNoOutput) {
 void interruptAndCheck(const std::string& vdbPath, const test::ScratchDir& scratch, int sig) {
     const std::string tag = std::to_string(sig);
     const std::string dir = scratch.path("int" + tag), outPath = scratch.path("o" + tag), errPath = scratch.path("e" + tag);
-    std::vector<std::string> all{VDBSPLAT_BINARY, "animate", vdbPath, "-o", dir, "--from", "8", "--to", "0.5",
-                                 "--frames", "3000", "--size", "16x16", "--threads", "1"};
-    std::vector<char*> argv;
-    for (std::string& a : all) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawnattr_t attr;
-    posix_spawnattr_init(&attr);
-    sigset_t defaults;
-    sigemptyset(&defaults);
-    sigaddset(&defaults, SIGINT);
-    sigaddset(&defaults, SIGTERM);
-    posix_spawnattr_setsigdefault(&attr, &defaults);
-    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
-    pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, &attr, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
-    posix_spawnattr_destroy(&attr);
+    const pid_t pid = test::spawnVdbsplat({"animate", vdbPath, "-o", dir, "--from", "8", "--to", "0.5", "--frames",
+                                           "3000", "--size", "16x16", "--threads", "1"},
+                                          outPath, errPath);
+    ASSERT_GT(pid, 0);
     for (int i = 0; i < 1200 && !fs::exists(dir + "/frame_0003.png"); ++i)
         std::this_thread::sleep_for(std::chrono::milliseconds(25));
     ::kill(pid, sig);
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
+    const int status = test::waitBounded(pid, 120);
     ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     EXPECT_EQ(WEXITSTATUS(status), 1);
     const std::string err = slurp(errPath);

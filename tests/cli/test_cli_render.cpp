@@ -471,3 +471,62 @@ TEST_F(CliRender, ImageIndependentOfThreadsAndOfTablesSource) {
 
 }  // namespace
 }  // namespace vdbsplat
+
+namespace vdbsplat {
+namespace {
+
+/// Starts a reference render long enough to be interrupted (-v: progress lines on stderr,
+/// which is a file here), waits for its first progress line, sends @p sig, and checks the
+/// contract: exit 1, the error as the last stderr line, no image and no temporary left.
+void interruptRender(const std::string& input, const fs::path& dir, int sig, bool verbose) {
+    const std::string image = (dir / "out.png").string(), outPath = (dir / "o.txt").string(),
+                      errPath = (dir / "e.txt").string();
+    std::vector<std::string> args{"render", input, "-o", image, "--mode", "reference", "--spp", "1024",
+                                  "--size", "400x400", "--threads", "1"};
+    if (verbose) args.push_back("-v");
+    const pid_t pid = test::spawnVdbsplat(args, outPath, errPath);
+    ASSERT_GT(pid, 0);
+    if (verbose) {  // the progress line proves -v reports while rendering, and that it has begun
+        for (int i = 0; i < 2400 && slurp(errPath).find("reference:  10%") == std::string::npos; ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    }
+    EXPECT_TRUE(test::waitForHandler(pid, sig, 60));  // the guard is installed before the grid loads
+    ::kill(pid, sig);
+    const int status = test::waitBounded(pid, 60);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+    const std::string err = slurp(errPath);
+    const std::string name = sig == SIGINT ? "SIGINT" : "SIGTERM";
+    const std::string last = "vdbsplat: error: render interrupted by " + name + "; " + image + " not written\n";
+    ASSERT_GE(err.size(), last.size()) << err;
+    EXPECT_EQ(err.substr(err.size() - last.size()), last) << err;
+    if (verbose) {
+        EXPECT_NE(err.find("reference:  10%  ETA "), std::string::npos) << err;
+        EXPECT_EQ(err.find("100%"), std::string::npos) << err;  // it did not finish
+    } else {
+        EXPECT_EQ(err, last);  // one line
+    }
+    EXPECT_TRUE(slurp(outPath).empty());
+    EXPECT_FALSE(fs::exists(image));
+    test::expectNoTemporaries(dir);
+}
+
+TEST_F(CliRender, CtrlCStopsALongRenderAndWritesNothing) {
+    interruptRender(vdb("sphere.vdb"), runDir("int"), SIGINT, false);
+}
+
+TEST_F(CliRender, VerboseShowsProgressAndSigtermStopsIt) {
+    interruptRender(vdb("sphere.vdb"), runDir("term"), SIGTERM, true);
+}
+
+TEST_F(CliRender, VerboseProgressEndsAtOneHundredPercent) {
+    const fs::path d = runDir("v");
+    const test::CliResult r = test::runVdbsplat(
+        "render '" + vdb("sphere.vdb") + "' -o '" + (d / "out" / "a.png").string() + "' --size 32x32 -v", d / "log");
+    EXPECT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("hybrid: 100%  done in "), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("hybrid 32x32"), std::string::npos) << r.out;  // the one-line statistics
+}
+
+}  // namespace
+}  // namespace vdbsplat

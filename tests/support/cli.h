@@ -4,16 +4,24 @@
 // contract of every command (non-zero exit, exactly one stderr line "vdbsplat: error: …"
 // naming the file or flag, nothing on stdout, no temporary left behind).
 #pragma once
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
 #include <stdlib.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 namespace vdbsplat::test {
 
@@ -85,6 +93,67 @@ inline CliResult runVdbsplat(const std::string& args, const fs::path& logDir, in
                              const std::string& shellPrefix = "") {
     const std::string timeout = timeoutSeconds > 0 ? "timeout -k 5 " + std::to_string(timeoutSeconds) + " " : "";
     return runShell(shellPrefix + timeout + "'" + VDBSPLAT_BINARY + "' " + args, logDir);
+}
+
+/// @brief Starts `vdbsplat ARGS` without a shell, SIGINT and SIGTERM at their default (as in
+/// a terminal: a shell's background job would ignore SIGINT), stdout and stderr to files.
+/// @return the child's pid (0 when it could not be started; a test failure is added).
+inline pid_t spawnVdbsplat(std::vector<std::string> args, const std::string& outPath, const std::string& errPath) {
+    args.insert(args.begin(), VDBSPLAT_BINARY);
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    sigset_t defaults;
+    sigemptyset(&defaults);
+    sigaddset(&defaults, SIGINT);
+    sigaddset(&defaults, SIGTERM);
+    posix_spawnattr_setsigdefault(&attr, &defaults);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
+    pid_t pid = 0;
+    if (posix_spawn(&pid, argv[0], &actions, &attr, argv.data(), environ) != 0) {
+        ADD_FAILURE() << "posix_spawn " << argv[0] << " failed";
+        pid = 0;
+    }
+    posix_spawn_file_actions_destroy(&actions);
+    posix_spawnattr_destroy(&attr);
+    return pid;
+}
+
+/// @brief Waits (at most @p boundSeconds) until process @p pid catches signal @p sig, read
+/// from /proc/PID/status "SigCgt", so a test's signal finds the handler and not the default.
+/// @return false when it never did.
+inline bool waitForHandler(pid_t pid, int sig, int boundSeconds) {
+    for (int i = 0; i < boundSeconds * 50; ++i) {
+        std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+        for (std::string line; std::getline(status, line);)
+            if (line.rfind("SigCgt:", 0) == 0 && (std::stoull(line.substr(7), nullptr, 16) >> (sig - 1)) & 1u)
+                return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+}
+
+/// @brief Waits for @p pid; kills it (SIGKILL) when it has not ended within @p boundSeconds,
+/// a bound on time, never a timed assertion. @return the wait status.
+inline int waitBounded(pid_t pid, int boundSeconds) {
+    int status = 0;
+    for (int i = 0; i < boundSeconds * 20; ++i) {
+        const pid_t r = waitpid(pid, &status, WNOHANG);
+        if (r == pid) return status;
+        if (r < 0 && errno != EINTR) return status;
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ADD_FAILURE() << "pid " << pid << " still running after " << boundSeconds << " s: killed";
+    ::kill(pid, SIGKILL);
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    return status;
 }
 
 /// @brief The error contract: non-zero exit, exactly one stderr line "vdbsplat: error: …"

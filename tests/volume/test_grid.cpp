@@ -242,6 +242,23 @@ TEST_F(Grid, MetadataSizesMustMatchWhatOpenVdbReads) {
     }
 }
 
+// Found by fuzzing: a 41-byte file of file version 0 went to OpenVDB unchecked (pre-release
+// layouts) and took 135 MB and a second (half a minute under ASan) to fail.
+TEST_F(Grid, PreReleaseFileVersionsAreRefused) {
+    const std::string good = write("v.vdb", {smallGrid()});
+    std::ifstream in(good, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (const uint32_t version : {0u, 1u, 212u}) {
+        std::memcpy(bytes.data() + 8, &version, 4);
+        const std::string old = path("old.vdb");
+        std::ofstream(old, std::ios::binary | std::ios::trunc).write(bytes.data(), std::streamsize(bytes.size()));
+        EXPECT_EQ(errorOf([&] { loadVolume(old); }),
+                  old + ": VDB file version " + std::to_string(version) +
+                      " is older than any OpenVDB release (213 or later is read)");
+        EXPECT_TRUE(has(errorOf([&] { describeFile(old); }), "is older than any OpenVDB release"));
+    }
+}
+
 // The child-process read turns an OpenVDB crash into an Error (fuzzing found a flipped byte
 // in a compressed chunk header that corrupts OpenVDB's heap: "corrupted size vs. prev_size",
 // abort), passes the child's Error message on, and returns when the read succeeds.
