@@ -75,7 +75,12 @@ std::string worldBox(const openvdb::math::Transform& xform, const openvdb::Coord
 
 std::string matrixText(const openvdb::math::Transform& xform) {
     if (!xform.isLinear()) return "    (" + printable(xform.mapType()) + ": not linear, no matrix)\n";
-    const openvdb::Mat4d m = xform.baseMap()->getAffineMap()->getMat4();
+    openvdb::Mat4d m;
+    try {  // OpenVDB inverts the matrix as it builds the affine map: a singular one throws
+        m = xform.baseMap()->getAffineMap()->getMat4();
+    } catch (const std::exception& e) {
+        return "    (singular or invalid: " + printable(e.what()) + ")\n";
+    }
     std::ostringstream s;
     s << std::setprecision(9);
     for (int r = 0; r < 4; ++r)
@@ -148,11 +153,15 @@ std::string describeFile(const std::string& path) {
     std::string version;
     readInChildProcess(path, [&] { readAllGrids(path, version); });  // a crash there is an Error here
     const openvdb::GridPtrVecPtr grids = readAllGrids(path, version);
-    log.keep();
     std::ostringstream s;
     s << printable(path) << ": VDB file version " << printable(version) << ", " << grids->size() << " grid" << (grids->size() == 1 ? "" : "s")
       << "\n";
-    for (size_t i = 0; i < grids->size(); ++i) s << describeGrid(*(*grids)[i], i);
+    try {
+        for (size_t i = 0; i < grids->size(); ++i) s << describeGrid(*(*grids)[i], i);
+    } catch (const std::exception& e) {  // OpenVDB's own exceptions from a grid it read
+        throw Error(path + ": corrupt VDB file (" + std::string(e.what()) + ")");
+    }
+    log.keep();  // OpenVDB's warnings only beside a description, never beside the error
     return s.str();
 }
 

@@ -70,7 +70,12 @@ openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::stri
 /// The index→world matrix of a linear transform with uniform scale; refuses anything else.
 glm::dmat4 linearUniformMap(const openvdb::math::Transform& transform, const std::string& label, double& voxelSize) {
     if (!transform.isLinear()) throw Error(label + ": transform is not linear (frustum maps are not supported)");
-    const openvdb::Mat4d m = transform.baseMap()->getAffineMap()->getMat4();
+    openvdb::Mat4d m;
+    try {  // OpenVDB inverts the matrix as it builds the affine map: a singular one throws
+        m = transform.baseMap()->getAffineMap()->getMat4();
+    } catch (const std::exception& e) {
+        throw Error(label + ": transform is singular or invalid (" + std::string(e.what()) + ")");
+    }
     glm::dmat4 map(1.0);
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) map[c][r] = m(c, r);  // OpenVDB is row-vector: world = [i j k 1]·m

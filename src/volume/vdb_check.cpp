@@ -307,8 +307,10 @@ ChildRead::ChildRead(const std::string& path, const std::function<void(const std
         std::string message;
         try {
             read(hint);
-        } catch (const std::exception& e) {
+        } catch (const Error& e) {
             message = e.what();
+        } catch (const std::exception& e) {  // a library's exception: name the file
+            message = path + ": corrupt VDB file (" + std::string(e.what()) + ")";
         } catch (...) {
             message = path + ": corrupt VDB file";
         }

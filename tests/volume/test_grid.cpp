@@ -259,6 +259,38 @@ TEST_F(Grid, PreReleaseFileVersionsAreRefused) {
     }
 }
 
+// Found by fuzzing: a ScaleMap with a zero scale (OpenVDB never writes one, but reads it)
+// made OpenVDB throw its own ArithmeticError ("Inversion of singular 4x4 matrix") out of
+// `info` (an uncaught exception in the fuzzer; in the CLI an error line without the file's
+// name, after a leaked OpenVDB warning) and out of the load.
+TEST_F(Grid, SingularTransformIsOneErrorNamingTheFile) {
+    auto grid = smallGrid();
+    grid->setTransform(openvdb::math::Transform::Ptr(
+        new openvdb::math::Transform(openvdb::math::MapBase::Ptr(new openvdb::math::ScaleMap(openvdb::Vec3d(1, 2, 3))))));
+    const std::string good = write("scale.vdb", {grid});
+    std::ifstream in(good, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const size_t at = bytes.find(std::string("\x08\0\0\0ScaleMap", 12));
+    ASSERT_NE(at, std::string::npos);
+    double y = 0.0;
+    std::memcpy(&y, bytes.data() + at + 12 + 8, 8);
+    ASSERT_EQ(y, 2.0);  // the scale's y component
+    y = 0.0;
+    std::memcpy(bytes.data() + at + 12 + 8, &y, 8);
+    const std::string bad = path("singular.vdb");
+    std::ofstream(bad, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    std::ostringstream err;
+    std::streambuf* previous = std::cerr.rdbuf(err.rdbuf());
+    const std::string load = errorOf([&] { loadVolume(bad); });
+    std::string info;
+    EXPECT_NO_THROW(info = describeFile(bad));
+    std::cerr.rdbuf(previous);
+    EXPECT_EQ(load.rfind(bad + ": grid 'density'", 0), 0u) << load;
+    EXPECT_TRUE(has(load, "transform is singular or invalid")) << load;
+    EXPECT_TRUE(has(info, "singular or invalid")) << info;
+    EXPECT_EQ(err.str(), "");
+}
+
 // The child-process read turns an OpenVDB crash into an Error (fuzzing found a flipped byte
 // in a compressed chunk header that corrupts OpenVDB's heap: "corrupted size vs. prev_size",
 // abort), passes the child's Error message on, and returns when the read succeeds.
