@@ -62,6 +62,18 @@ void checkMagic(const std::string& path, const std::string& line) {
                     "')");
 }
 
+/// Reads one line (without its '\n') of at most @p limit bytes; false at the end of the file.
+bool boundedLine(std::istream& in, std::string& line, uint64_t limit, uint64_t& used) {
+    line.clear();
+    int c = 0;
+    while ((c = in.get()) != EOF && c != '\n') {
+        if (++used > limit) return true;
+        line += char(c);
+    }
+    if (c == '\n') ++used;
+    return c == '\n' || !line.empty();
+}
+
 /// Reads the header lines of @p path (at most kMaxNrrdHeaderBytes).
 NrrdFields readFields(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
@@ -69,8 +81,7 @@ NrrdFields readFields(const std::string& path) {
     NrrdFields out;
     std::string line;
     uint64_t used = 0;
-    for (int n = 0; std::getline(in, line); ++n) {
-        used += line.size() + 1;
+    for (int n = 0; boundedLine(in, line, kMaxNrrdHeaderBytes, used); ++n) {
         if (used > kMaxNrrdHeaderBytes)
             throw Error(path + ": header is longer than " + std::to_string(kMaxNrrdHeaderBytes) + " bytes (no blank line ends it)");
         if (!line.empty() && line.back() == '\r') line.pop_back();

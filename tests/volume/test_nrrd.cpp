@@ -180,19 +180,19 @@ TEST_F(NrrdBad, GeometryFields) {
 TEST_F(NrrdBad, DetachedDataAndByteSkip) {
     std::ofstream(dir_ + "/data.raw", std::ios::binary) << std::string(64, 2);
     const std::string det = kHead + "sizes: 4 4 4\nencoding: raw\n";
-    EXPECT_EQ(nrrd(write("ok.nhdr", det + "data file: data.raw"))->activeVoxelCount(), 64u);
-    expectError(write("missing.nhdr", det + "data file: nope.raw"), "data file");
-    expectError(write("missing2.nhdr", det + "data file: nope.raw"), "no such file");
+    EXPECT_EQ(nrrd(write("ok.nhdr", det + "data file: data.raw", ""))->activeVoxelCount(), 64u);
+    expectError(write("missing.nhdr", det + "data file: nope.raw", ""), "data file");
+    expectError(write("missing2.nhdr", det + "data file: nope.raw", ""), "no such file");
     expectError(write("list.nhdr", det + "data file: LIST\n"), "data file: only one data file");
-    expectError(write("dev.nhdr", det + "data file: /dev/zero"), "not a regular file");
-    expectError(write("nodata.nhdr", det.substr(0, det.size() - 1)), "data file: missing");
+    expectError(write("dev.nhdr", det + "data file: /dev/zero", ""), "not a regular file");
+    expectError(write("nodata.nhdr", det.substr(0, det.size() - 1), ""), "data file: missing");
     // byte skip: 10 junk bytes before the voxels (attached); -1: the voxels end the file.
     const auto skipped = nrrd(write("skip.nrrd", kHead + "sizes: 4 4 4\nencoding: raw\nbyte skip: 10\n",
                                     std::string(10, 9) + std::string(64, 1)));
     EXPECT_EQ(skipped->activeVoxelCount(), 64u);
     EXPECT_FLOAT_EQ(skipped->tree().getValue(openvdb::Coord(0, 0, 0)), 1.0f / 255.0f);
     std::ofstream(dir_ + "/end.raw", std::ios::binary) << std::string(5, 9) << std::string(64, 3);
-    const auto atEnd = nrrd(write("end.nhdr", det + "byte skip: -1\ndata file: end.raw"));
+    const auto atEnd = nrrd(write("end.nhdr", det + "byte skip: -1\ndata file: end.raw", ""));
     EXPECT_EQ(atEnd->activeVoxelCount(), 64u);
     EXPECT_FLOAT_EQ(atEnd->tree().getValue(openvdb::Coord(0, 0, 0)), 3.0f / 255.0f);
 }
