@@ -62,10 +62,14 @@ public:
     FileSource(const std::string& path, uint64_t offset, const std::string& what) : what_(what) {
         std::error_code ec;
         size_ = std::filesystem::file_size(path, ec);
+        if (ec) throw Error(path + ": cannot read its size");
+        if (offset > size_) throw Error(what + ": offset " + std::to_string(offset) + " is past the end of the file");
         file_ = std::fopen(path.c_str(), "rb");
-        if (ec || !file_) throw Error(path + ": cannot open");
-        if (offset > size_ || std::fseek(file_, long(offset), SEEK_SET) != 0)
-            throw Error(what + ": offset " + std::to_string(offset) + " is past the end of the file");
+        if (!file_) throw Error(path + ": cannot open");
+        if (std::fseek(file_, long(offset), SEEK_SET) != 0) {
+            std::fclose(file_);
+            throw Error(what + ": cannot seek to byte " + std::to_string(offset));
+        }
         pos_ = offset;
     }
     ~FileSource() override { std::fclose(file_); }
@@ -507,6 +511,10 @@ private:
         if (!xml_.appended) throw Error(what + ": format appended, but the file has no AppendedData");
         if (!array.attribute("offset")) throw Error(what + " offset: missing (needed for appended data)");
         const uint64_t offset = uint64_t(parseInt(attr(array, "offset"), what + " offset", 0, 1LL << 50));
+        std::error_code ec;
+        const uint64_t size = std::filesystem::file_size(path_, ec);
+        if (ec || offset > size - std::min(size, xml_.appendedStart))
+            throw Error(what + " offset: " + std::to_string(offset) + " is past the end of the appended data");
         const std::string encodingName = attr(doc_.child("VTKFile").child("AppendedData"), "encoding");
         if (encodingName == "raw") {
             FileSource data(path_, xml_.appendedStart + offset, what);

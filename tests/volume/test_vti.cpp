@@ -240,7 +240,7 @@ TEST_F(VtiBad, DataThatDoesNotMatchTheExtent) {
     expectError(write("i.vti", p), "truncated");
     p.cut = false;
     p.array = R"(type="UInt8" Name="d" format="appended" offset="999999")";
-    expectError(write("j.vti", p), "offset 999999 is past the end");
+    expectError(write("j.vti", p), "offset: 999999 is past the end");
 }
 
 TEST_F(VtiBad, CompressedBlocksThatLieAboutTheirSize) {
