@@ -254,7 +254,8 @@ TEST_F(VtiBad, CompressedBlocksThatLieAboutTheirSize) {
     expectError(write("b.vti", zlibParts(header(1, 4, 4, {uint32_t(five.size())}), five)), "inflates to more than the 4 bytes");
     expectError(write("c.vti", zlibParts(header(1, 4, 4, {uint32_t(four.size()) - 2}), four)), "zlib block 0");
     expectError(write("d.vti", zlibParts(header(1, 4, 4, {1000}), four)), "compressed size 1000 is more than");
-    expectError(write("e.vti", zlibParts(header(1, 8, 8, {uint32_t(four.size())}), four)), "does not fit the 4 bytes");
+    expectError(write("e.vti", zlibParts(header(1, 8, 8, {uint32_t(four.size())}), four)), "gives 8 bytes, WholeExtent needs 4");
+    expectError(write("e2.vti", zlibParts(header(2, 8, 2, {3, 3}), four)), "does not fit the 4 bytes");
     expectError(write("f.vti", zlibParts(header(0xffffffffu, 1, 1, {}), four)), "does not fit");
     expectError(write("g.vti", zlibParts(header(2, 2, 2, {3}), four)), "zlib block 0");
     std::string corrupt = four;
