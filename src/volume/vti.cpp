@@ -184,7 +184,7 @@ XmlPart readXmlPart(const std::string& path) {
     if (!file) throw Error(path + ": cannot open (" + std::strerror(errno) + ")");
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> guard(file, std::fclose);
     XmlPart out;
-    std::vector<char> chunk(size_t(1) << 20);
+    std::vector<char> chunk(size_t(1) << 16);
     size_t found = std::string::npos;
     while (found == std::string::npos) {
         const size_t got = std::fread(chunk.data(), 1, chunk.size(), file);
