@@ -24,6 +24,7 @@ namespace vdbsplat {
 namespace {
 
 constexpr size_t kChunkBytes = size_t(4) << 20;  ///< rows are read in chunks of at most ~4 MiB
+constexpr uint64_t kMaxCountedExtra = uint64_t(1) << 26;  ///< bytes past the voxels counted for the error
 
 /// Reads a plain or gzip-compressed file (several concatenated gzip members are one
 /// stream, as gzip writes them); every failure is an Error naming the path. Anything after
@@ -57,13 +58,14 @@ public:
     /// Reads up to @p n bytes; fewer only at the end of the data.
     size_t read(unsigned char* out, size_t n) { return gzip_ ? inflateInto(out, n) : copyInto(out, n); }
 
-    /// Reads and counts every remaining byte (bounded buffer).
-    uint64_t countRest() {
+    /// Reads and counts the remaining bytes, stopping past @p limit (a gzip bomb after the
+    /// voxels would otherwise be inflated to its end just to count it).
+    uint64_t countRest(uint64_t limit) {
         std::vector<unsigned char> buffer(1 << 16);
         uint64_t total = 0;
         while (size_t got = read(buffer.data(), buffer.size())) {
             total += got;
-            if (got < buffer.size()) break;
+            if (got < buffer.size() || total > limit) break;
         }
         return total;
     }
@@ -185,8 +187,9 @@ void streamInto(GzReader& reader, const VoxelSource& source, const VoxelLayout& 
         if (got < want)
             throw Error(sizeMismatch(source, layout, expected, "only " + std::to_string(builder.bytes()) + " (too short)"));
     }
-    if (const uint64_t extra = reader.countRest())
-        throw Error(sizeMismatch(source, layout, expected, std::to_string(expected + extra) + " (too long)"));
+    if (const uint64_t extra = reader.countRest(kMaxCountedExtra))
+        throw Error(sizeMismatch(source, layout, expected,
+                                 (extra > kMaxCountedExtra ? "more than " : "") + std::to_string(expected + extra) + " (too long)"));
 }
 
 /// The file offset of plain data, checking the file's size against the layout before reading.
