@@ -5,7 +5,7 @@ set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config git
       libopenvdb-dev libboost-iostreams-dev libopenimageio-dev libglm-dev libtbb-dev
       libgtest-dev libbenchmark-dev nlohmann-json3-dev zlib1g-dev libhwy-dev
-      libpng-dev clang)  # clang: the sanitizer and libFuzzer build (scripts/sanitize.sh, scripts/fuzz.sh)
+      libpng-dev libpugixml-dev clang)  # clang: the sanitizer and libFuzzer build (scripts/sanitize.sh, scripts/fuzz.sh)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

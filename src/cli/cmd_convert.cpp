@@ -1,7 +1,11 @@
-// cli/cmd_convert.cpp — `vdbsplat convert IN.raw[.gz] -o OUT.vdb --dims X,Y,Z --type T
-// [--spacing SX,SY,SZ] [--threshold T]`.
-// Owns: the flags of the convert command; the reader itself is volume/raw.h.
+// cli/cmd_convert.cpp — `vdbsplat convert IN -o OUT.vdb`: IN is raw (.raw[.gz], needs --dims and
+// --type), NRRD (.nrrd, .nhdr) or VTK ImageData (.vti), picked by the file's extension.
+// Owns: the flags of the convert command, picking the reader, and refusing flags that a
+// header already answers; the readers are volume/raw.h, volume/nrrd.h and volume/vti.h.
+#include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 
 #include "cli/args.h"
@@ -10,64 +14,109 @@
 #include "util/error.h"
 #include "util/parse.h"
 #include "volume/grid.h"
+#include "volume/nrrd.h"
 #include "volume/raw.h"
+#include "volume/vti.h"
 
 namespace vdbsplat::cli {
 
 namespace {
 
 const char* kHelp =
-    "usage: vdbsplat convert IN.raw[.gz] -o OUT.vdb --dims X,Y,Z --type uint8|uint16|float32\n"
-    "                        [--spacing SX,SY,SZ] [--threshold T] [--max-voxels N]\n"
+    "usage: vdbsplat convert IN.raw[.gz] -o OUT.vdb --dims X,Y,Z --type T [--spacing SX,SY,SZ]\n"
+    "       vdbsplat convert IN.nrrd|IN.nhdr|IN.vti -o OUT.vdb [--array NAME]\n"
+    "                        [--threshold T] [--max-voxels N]\n"
     "\n"
-    "Converts a headerless raw volume (x fastest, then y, then z; plain or gzip-compressed,\n"
-    "streamed, never read whole) into a sparse float grid named 'density'.\n"
+    "Converts a volume into a sparse float grid named 'density'. The format is picked by the\n"
+    "extension: .nrrd / .nhdr (NRRD, encodings raw and gzip), .vti (VTK XML ImageData: ascii,\n"
+    "base64 or appended data, zlib-compressed or not), anything else is headerless raw (x fastest,\n"
+    "then y, then z; plain or gzip-compressed). Files are streamed, never read whole (except the\n"
+    "XML of a .vti with inline data). NRRD and VTI keep their spacing, origin and directions in\n"
+    "the grid's transform; `render` needs cubic voxels (rotations are fine).\n"
     "\n"
     "options:\n"
     "  -o OUT.vdb            output file (written atomically)\n"
-    "  --dims X,Y,Z          voxel counts, each 1..65536; the file must hold exactly X*Y*Z voxels\n"
-    "  --type T              uint8 | uint16 (little-endian) | float32 (little-endian);\n"
-    "                        integers are normalised to [0,1] (/255, /65535), float32 is kept\n"
-    "  --spacing SX,SY,SZ    voxel size in world units, 1e-4..1e6 (default 1,1,1); must be uniform\n"
-    "                        (non-uniform spacing is refused: the renderer needs cubic voxels)\n"
+    "  --dims X,Y,Z          raw only: voxel counts, each 1..65536; the file must hold exactly X*Y*Z voxels\n"
+    "  --type T              raw only: uint8 | int16 | uint16 | float32 | float64 (little-endian);\n"
+    "                        integers are normalised (/255, /32767, /65535), floats are kept\n"
+    "  --spacing SX,SY,SZ    raw only: voxel size in world units, 1e-4..1e6 (default 1,1,1); must be\n"
+    "                        uniform (non-uniform spacing is refused: the renderer needs cubic voxels)\n"
+    "  --array NAME          .vti only: the PointData array to read (default: the active Scalars,\n"
+    "                        else the first one-component array)\n"
     "  --threshold T         a voxel is active iff its normalised value is > T (default 0:\n"
-    "                        zeros are background); float32 NaN/inf voxels stay inactive\n"
-    "  --max-voxels N        refuse --dims whose X*Y*Z exceeds N (default 2^26 = 67108864, at most 2^32)\n";
+    "                        zeros are background); NaN/inf voxels stay inactive\n"
+    "  --max-voxels N        refuse volumes whose X*Y*Z exceeds N (default 2^26 = 67108864, at most 2^32)\n";
 
-RawSpec specFrom(const Args& args) {
+enum class Format { Raw, Nrrd, Vti };
+
+Format formatOf(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".nrrd" || ext == ".nhdr") return Format::Nrrd;
+    if (ext == ".vti") return Format::Vti;
+    return Format::Raw;
+}
+
+ConvertOptions optionsFrom(const Args& args) {
+    ConvertOptions o;
+    if (auto t = args.get("--threshold")) o.threshold = parseDouble(*t, "--threshold");
+    if (auto m = args.get("--max-voxels"))
+        o.maxVoxels = uint64_t(parseInt(*m, "--max-voxels", 1, (long long)kHardMaxRawVoxels));
+    if (auto a = args.get("--array")) o.array = *a;
+    return o;
+}
+
+RawSpec specFrom(const Args& args, const ConvertOptions& options) {
+    if (args.has("--array")) throw Error("--array: only for .vti input");
     RawSpec spec;
     spec.dims = parseDims(args.require("--dims"), "--dims");
     spec.type = parseRawType(args.require("--type"), "--type");
     if (auto s = args.get("--spacing")) spec.spacing = parseUniformSpacing(*s, "--spacing");
-    if (auto t = args.get("--threshold")) spec.threshold = parseDouble(*t, "--threshold");
-    if (auto m = args.get("--max-voxels"))
-        spec.maxVoxels = uint64_t(parseInt(*m, "--max-voxels", 1, (long long)kHardMaxRawVoxels));
+    spec.threshold = options.threshold;
+    spec.maxVoxels = options.maxVoxels;
     return spec;
+}
+
+/// Refuses the raw-only flags for a file whose header gives them.
+void refuseRawFlags(const Args& args, const std::string& in, Format format) {
+    const char* field[] = {"sizes / WholeExtent", "type", "spacings / Spacing"};
+    const char* flags[] = {"--dims", "--type", "--spacing"};
+    for (int i = 0; i < 3; ++i)
+        if (args.has(flags[i]))
+            throw Error(std::string(flags[i]) + ": conflicts with the header of " + in + " (its " + field[i] +
+                        " field gives it; the flag is for raw input only)");
+    if (format == Format::Nrrd && args.has("--array")) throw Error("--array: only for .vti input");
+}
+
+openvdb::FloatGrid::Ptr convert(const Args& args, const std::string& in, const ConvertOptions& options, RawStats& stats) {
+    const Format format = formatOf(in);
+    if (format == Format::Raw) return convertRaw(in, specFrom(args, options), &stats);
+    refuseRawFlags(args, in, format);
+    return format == Format::Nrrd ? convertNrrd(in, options, &stats) : convertVti(in, options, &stats);
 }
 
 }  // namespace
 
 int runConvert(const Argv& argv) {
-    const Args args(argv, {"-o", "--dims", "--type", "--spacing", "--threshold", "--max-voxels"}, {});
+    const Args args(argv, {"-o", "--dims", "--type", "--spacing", "--threshold", "--max-voxels", "--array"}, {});
     if (args.wantsHelp()) {
         std::cout << kHelp;
         return 0;
     }
-    const std::string in = args.onePositional("input file IN.raw[.gz]");
+    const std::string in = args.onePositional("input file IN");
     const std::string out = args.require("-o");
-    const RawSpec spec = specFrom(args);
+    const ConvertOptions options = optionsFrom(args);
     checkRegularOutputPath(out, "-o");
     const auto start = std::chrono::steady_clock::now();
     RawStats stats;
-    auto grid = convertRaw(in, spec, &stats);
+    auto grid = convert(args, in, options, stats);
     if (stats.active == 0)
-        throw Error(in + ": no voxel is above --threshold " + std::to_string(spec.threshold) + "; nothing to write");
+        throw Error(in + ": no voxel is above --threshold " + std::to_string(options.threshold) + "; nothing to write");
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     writeVolume(out, grid);
-    std::cout << "wrote " << out << ": " << stats.active << " active voxels of "
-              << uint64_t(spec.dims[0]) * spec.dims[1] * spec.dims[2] << ", index box "
-              << grid->evalActiveVoxelBoundingBox() << ", voxel size " << spec.spacing << ", converted in " << seconds
-              << " s";
+    std::cout << "wrote " << out << ": " << stats.active << " active voxels of " << stats.voxels << ", index box "
+              << grid->evalActiveVoxelBoundingBox() << ", voxel size " << grid->voxelSize() << ", converted in "
+              << seconds << " s";
     if (stats.nonFinite) std::cout << " (" << stats.nonFinite << " NaN/inf voxels left inactive)";
     std::cout << "\n";
     return 0;

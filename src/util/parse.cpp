@@ -9,7 +9,7 @@
 namespace vdbsplat {
 
 namespace {
-std::string quoted(std::string_view text) { return "'" + std::string(text) + "'"; }
+std::string quoted(std::string_view text) { return "'" + printable(text) + "'"; }
 std::string_view trim(std::string_view s) {
     while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
     while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
@@ -64,6 +64,12 @@ void parseSize(std::string_view text, const std::string& what, int maxSide, int&
     if (x == std::string_view::npos) throw Error(what + ": expected WxH (e.g. 400x400), got " + quoted(text));
     width = static_cast<int>(parseInt(text.substr(0, x), what + " width", 1, maxSide));
     height = static_cast<int>(parseInt(text.substr(x + 1), what + " height", 1, maxSide));
+}
+
+std::string printable(std::string_view text, size_t maxChars) {
+    std::string out;
+    for (char c : text.substr(0, maxChars)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
+    return text.size() > maxChars ? out + "..." : out;
 }
 
 }  // namespace vdbsplat

@@ -25,4 +25,8 @@ std::vector<double> parseDoubleList(std::string_view text, const std::string& wh
 /// @throw Error naming @p what when malformed or out of range.
 void parseSize(std::string_view text, const std::string& what, int maxSide, int& width, int& height);
 
+/// @brief @p text for an error message: bytes other than printable ASCII become '?' (a file's
+/// header cannot send terminal escapes), cut to @p maxChars with "..." after.
+std::string printable(std::string_view text, size_t maxChars = 60);
+
 }  // namespace vdbsplat

@@ -1,7 +1,8 @@
 // volume/raw.cpp — raw volume conversion through zlib (see raw.h).
-// Owns: a small RAII gzip reader (zlib inflate; trailing garbage refused), the per-type decoding (little-endian), the
-// threshold rule, and the exact size check (plain files before reading, .gz files
-// by counting the decompressed bytes, both too short and too long).
+// Owns: a small RAII gzip reader (zlib inflate; trailing garbage refused), the per-type decoding (either byte
+// order), the normalisation and threshold rule (DensityBuilder, shared by every convert format), and the
+// exact size check (plain files before reading, .gz files by counting the decompressed bytes, both too
+// short and too long).
 #include "volume/raw.h"
 
 #include <zlib.h>
@@ -12,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <vector>
 
 #include "util/error.h"
@@ -22,15 +24,7 @@ namespace vdbsplat {
 namespace {
 
 constexpr size_t kChunkBytes = size_t(4) << 20;  ///< rows are read in chunks of at most ~4 MiB
-
-const char* typeName(RawType type) {
-    switch (type) {
-        case RawType::UInt8: return "uint8";
-        case RawType::UInt16: return "uint16";
-        case RawType::Float32: return "float32";
-    }
-    return "?";
-}
+constexpr uint64_t kMaxCountedExtra = uint64_t(1) << 26;  ///< bytes past the voxels counted for the error
 
 /// Reads a plain or gzip-compressed file (several concatenated gzip members are one
 /// stream, as gzip writes them); every failure is an Error naming the path. Anything after
@@ -38,16 +32,18 @@ const char* typeName(RawType type) {
 /// that is not what it claims never converts silently.
 class GzReader {
 public:
-    explicit GzReader(const std::string& path) : path_(path) {
-        std::error_code ec;
-        if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
-        if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a regular file");
+    /// Opens @p path at byte @p offset; @p encoding Detect: gzip iff the data starts with its magic.
+    GzReader(const std::string& path, const std::string& label, uint64_t offset, VoxelSource::Encoding encoding)
+        : path_(label) {
         file_ = std::fopen(path.c_str(), "rb");
-        if (!file_) throw Error(path + ": cannot open (" + std::strerror(errno) + ")");
+        if (!file_) throw Error(label + ": cannot open (" + std::strerror(errno) + ")");
+        if (offset > uint64_t(std::numeric_limits<long>::max()) || std::fseek(file_, long(offset), SEEK_SET) != 0)
+            throw Error(label + ": cannot seek to byte " + std::to_string(offset));
         input_.resize(size_t(1) << 18);
         refill();
-        gzip_ = strm_.avail_in >= 2 && input_[0] == 0x1f && input_[1] == 0x8b;
-        if (gzip_ && inflateInit2(&strm_, 15 + 16) != Z_OK) throw Error(path + ": cannot start zlib");
+        const bool magic = strm_.avail_in >= 2 && input_[0] == 0x1f && input_[1] == 0x8b;
+        gzip_ = encoding == VoxelSource::Encoding::Gzip || (encoding == VoxelSource::Encoding::Detect && magic);
+        if (gzip_ && inflateInit2(&strm_, 15 + 16) != Z_OK) throw Error(label + ": cannot start zlib");
     }
     ~GzReader() {
         if (gzip_) inflateEnd(&strm_);
@@ -62,13 +58,14 @@ public:
     /// Reads up to @p n bytes; fewer only at the end of the data.
     size_t read(unsigned char* out, size_t n) { return gzip_ ? inflateInto(out, n) : copyInto(out, n); }
 
-    /// Reads and counts every remaining byte (bounded buffer).
-    uint64_t countRest() {
+    /// Reads and counts the remaining bytes, stopping past @p limit (a gzip bomb after the
+    /// voxels would otherwise be inflated to its end just to count it).
+    uint64_t countRest(uint64_t limit) {
         std::vector<unsigned char> buffer(1 << 16);
         uint64_t total = 0;
         while (size_t got = read(buffer.data(), buffer.size())) {
             total += got;
-            if (got < buffer.size()) break;
+            if (got < buffer.size() || total > limit) break;
         }
         return total;
     }
@@ -140,67 +137,104 @@ private:
     bool finished_ = false;
 };
 
-std::string sizeMismatch(const std::string& path, const RawSpec& spec, uint64_t expected, const std::string& actual) {
-    return path + ": size mismatch: --dims " + std::to_string(spec.dims[0]) + "," + std::to_string(spec.dims[1]) + "," +
-           std::to_string(spec.dims[2]) + " of " + typeName(spec.type) + " needs " + std::to_string(expected) +
-           " bytes, the file has " + actual;
+std::string labelOf(const VoxelSource& source) { return source.label.empty() ? source.path : source.label; }
+
+std::string sizeMismatch(const VoxelSource& source, const VoxelLayout& layout, uint64_t expected,
+                         const std::string& actual) {
+    const char sep = source.sizeField == "--dims" ? ',' : ' ';
+    return labelOf(source) + ": size mismatch: " + source.sizeField + " " + std::to_string(layout.dims[0]) + sep +
+           std::to_string(layout.dims[1]) + sep + std::to_string(layout.dims[2]) + " of " + rawTypeName(layout.type) +
+           " needs " + std::to_string(expected) + " bytes, the " + (source.offset || source.skip ? "data" : "file") +
+           " has " + actual;
 }
 
-/// Decodes voxel @p i of a little-endian row; returns the normalised value.
-double decode(const unsigned char* row, size_t i, RawType type) {
+/// Reads @p n bytes of @p p as an unsigned integer in the given byte order.
+uint64_t loadBits(const unsigned char* p, int n, bool bigEndian) {
+    uint64_t v = 0;
+    for (int k = 0; k < n; ++k) v |= uint64_t(p[bigEndian ? n - 1 - k : k]) << (8 * k);
+    return v;
+}
+
+/// Decodes one voxel; returns its normalised value (NaN for what float32 cannot hold).
+double decode(const unsigned char* p, RawType type, bool bigEndian) {
     switch (type) {
-        case RawType::UInt8: return row[i] / 255.0;
-        case RawType::UInt16: return (unsigned(row[2 * i]) | unsigned(row[2 * i + 1]) << 8) / 65535.0;
-        case RawType::Float32: {
-            const unsigned char* b = row + 4 * i;
-            const uint32_t bits = uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
-            return double(std::bit_cast<float>(bits));
+        case RawType::UInt8: return p[0] / 255.0;
+        case RawType::Int16: return int16_t(uint16_t(loadBits(p, 2, bigEndian))) / 32767.0;
+        case RawType::UInt16: return double(loadBits(p, 2, bigEndian)) / 65535.0;
+        case RawType::Float32: return double(std::bit_cast<float>(uint32_t(loadBits(p, 4, bigEndian))));
+        case RawType::Float64: {
+            const double v = std::bit_cast<double>(loadBits(p, 8, bigEndian));
+            return std::abs(v) <= double(std::numeric_limits<float>::max()) ? v : NAN;
         }
     }
     return 0.0;
 }
 
-/// Activates the voxels of @p rows consecutive rows starting at (0, y, z).
-void addRows(const unsigned char* data, int rows, int y, int z, const RawSpec& spec,
-             openvdb::FloatGrid::Accessor& acc, RawStats& stats) {
-    const int nx = spec.dims[0];
-    const size_t rowBytes = size_t(nx) * rawTypeSize(spec.type);
-    for (int r = 0; r < rows; ++r) {
-        const unsigned char* row = data + r * rowBytes;
-        for (int x = 0; x < nx; ++x) {
-            const double v = decode(row, size_t(x), spec.type);
-            if (!std::isfinite(v)) {
-                ++stats.nonFinite;
-                continue;
-            }
-            if (v > spec.threshold) {
-                acc.setValueOn(openvdb::Coord(x, y + r, z), float(v));
-                ++stats.active;
-            }
-        }
+/// Reads the voxels of @p source into @p builder (the size already checked for plain files).
+void streamInto(GzReader& reader, const VoxelSource& source, const VoxelLayout& layout, DensityBuilder& builder) {
+    const uint64_t expected = builder.expectedBytes();
+    std::vector<unsigned char> buffer(std::min<uint64_t>(kChunkBytes, std::max<uint64_t>(expected, source.skip) + 1));
+    for (uint64_t skipped = 0; skipped < source.skip;) {
+        const size_t got = reader.read(buffer.data(), size_t(std::min<uint64_t>(buffer.size(), source.skip - skipped)));
+        if (got == 0) throw Error(sizeMismatch(source, layout, expected, "fewer than its byte skip of " +
+                                                                             std::to_string(source.skip) + " bytes"));
+        skipped += got;
     }
+    while (builder.bytes() < expected) {
+        const size_t want = size_t(std::min<uint64_t>(buffer.size(), expected - builder.bytes()));
+        const size_t got = reader.read(buffer.data(), want);
+        builder.addBytes(buffer.data(), got);
+        if (got < want)
+            throw Error(sizeMismatch(source, layout, expected, "only " + std::to_string(builder.bytes()) + " (too short)"));
+    }
+    if (const uint64_t extra = reader.countRest(kMaxCountedExtra))
+        throw Error(sizeMismatch(source, layout, expected,
+                                 (extra > kMaxCountedExtra ? "more than " : "") + std::to_string(expected + extra) + " (too long)"));
 }
 
-/// Refuses dims whose product exceeds spec.maxVoxels before anything is read: a small
-/// gzip file can expand into billions of active voxels.
-void checkVoxelLimit(const RawSpec& spec) {
-    const uint64_t voxels = uint64_t(spec.dims[0]) * uint64_t(spec.dims[1]) * uint64_t(spec.dims[2]);
-    if (voxels <= spec.maxVoxels) return;
-    throw Error("--dims: " + std::to_string(spec.dims[0]) + "," + std::to_string(spec.dims[1]) + "," +
-                std::to_string(spec.dims[2]) + " is " + std::to_string(voxels) + " voxels, more than the limit of " +
-                std::to_string(spec.maxVoxels) + " (raise it with --max-voxels, at most " +
-                std::to_string(kHardMaxRawVoxels) + ")");
+/// The file offset of plain data, checking the file's size against the layout before reading.
+uint64_t plainOffset(const VoxelSource& source, const VoxelLayout& layout, uint64_t expected) {
+    std::error_code ec;
+    const uint64_t size = std::filesystem::file_size(source.path, ec);
+    if (ec) return source.offset + source.skip;
+    if (source.atEnd) {
+        if (size < expected) throw Error(sizeMismatch(source, layout, expected, std::to_string(size) + " (too short)"));
+        return size - expected;
+    }
+    const uint64_t start = source.offset + source.skip;
+    const uint64_t have = size >= start ? size - start : 0;
+    if (have != expected) throw Error(sizeMismatch(source, layout, expected, std::to_string(have)));
+    return start;
 }
 
 }  // namespace
 
-int rawTypeSize(RawType type) { return type == RawType::UInt8 ? 1 : type == RawType::UInt16 ? 2 : 4; }
+int rawTypeSize(RawType type) {
+    switch (type) {
+        case RawType::UInt8: return 1;
+        case RawType::Int16:
+        case RawType::UInt16: return 2;
+        case RawType::Float32: return 4;
+        case RawType::Float64: return 8;
+    }
+    return 1;
+}
+
+const char* rawTypeName(RawType type) {
+    switch (type) {
+        case RawType::UInt8: return "uint8";
+        case RawType::Int16: return "int16";
+        case RawType::UInt16: return "uint16";
+        case RawType::Float32: return "float32";
+        case RawType::Float64: return "float64";
+    }
+    return "?";
+}
 
 RawType parseRawType(std::string_view text, const std::string& flag) {
-    if (text == "uint8") return RawType::UInt8;
-    if (text == "uint16") return RawType::UInt16;
-    if (text == "float32") return RawType::Float32;
-    throw Error(flag + ": unknown type '" + std::string(text) + "' (choose uint8, uint16 or float32)");
+    for (RawType t : {RawType::UInt8, RawType::Int16, RawType::UInt16, RawType::Float32, RawType::Float64})
+        if (text == rawTypeName(t)) return t;
+    throw Error(flag + ": unknown type '" + std::string(text) + "' (choose uint8, int16, uint16, float32 or float64)");
 }
 
 std::array<int, 3> parseDims(std::string_view text, const std::string& flag) {
@@ -232,40 +266,94 @@ double parseUniformSpacing(std::string_view text, const std::string& flag) {
     return s[0];
 }
 
+uint64_t voxelCount(const std::array<int, 3>& dims) {
+    return uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
+}
+
+void checkVoxelLimit(const std::array<int, 3>& dims, uint64_t maxVoxels, const std::string& field) {
+    const uint64_t voxels = voxelCount(dims);
+    if (voxels <= maxVoxels) return;
+    throw Error(field + ": " + std::to_string(dims[0]) + "," + std::to_string(dims[1]) + "," + std::to_string(dims[2]) +
+                " is " + std::to_string(voxels) + " voxels, more than the limit of " + std::to_string(maxVoxels) +
+                " (raise it with --max-voxels, at most " + std::to_string(kHardMaxRawVoxels) + ")");
+}
+
+DensityBuilder::DensityBuilder(const VoxelLayout& layout, double threshold, openvdb::math::Transform::Ptr transform)
+    : layout_(layout),
+      threshold_(threshold),
+      grid_(openvdb::FloatGrid::create(0.0f)),
+      acc_(grid_->getAccessor()),
+      total_(voxelCount(layout.dims)) {
+    grid_->setName("density");
+    grid_->setGridClass(openvdb::GRID_FOG_VOLUME);
+    grid_->setTransform(transform);
+    stats_.voxels = total_;
+}
+
+void DensityBuilder::addVoxel(const unsigned char* bytes) {
+    const double v = decode(bytes, layout_.type, layout_.bigEndian);
+    if (!std::isfinite(v)) {
+        ++stats_.nonFinite;
+    } else if (v > threshold_) {
+        acc_.setValueOn(at_, float(v));
+        ++stats_.active;
+    }
+    ++next_;
+    if (++at_[0] < layout_.dims[0]) return;
+    at_[0] = 0;
+    if (++at_[1] < layout_.dims[1]) return;
+    at_[1] = 0;
+    ++at_[2];
+}
+
+void DensityBuilder::addBytes(const unsigned char* data, size_t n) {
+    const int size = rawTypeSize(layout_.type);
+    bytes_ += n;
+    stats_.bytes = bytes_;
+    while (n > 0 && pendingBytes_ > 0) {  // complete a voxel split across calls
+        pending_[pendingBytes_++] = *data++;
+        --n;
+        if (pendingBytes_ == size) {
+            pendingBytes_ = 0;
+            if (next_ < total_) addVoxel(pending_);
+        }
+    }
+    for (; n >= size_t(size) && next_ < total_; n -= size, data += size) addVoxel(data);
+    if (next_ < total_)
+        for (; n > 0; --n) pending_[pendingBytes_++] = *data++;
+}
+
+openvdb::FloatGrid::Ptr readVoxels(const VoxelSource& source, const VoxelLayout& layout, double threshold,
+                                   openvdb::math::Transform::Ptr transform, RawStats* stats) {
+    std::error_code ec;
+    if (!std::filesystem::exists(source.path, ec)) throw Error(labelOf(source) + ": no such file");
+    if (!std::filesystem::is_regular_file(source.path, ec)) throw Error(labelOf(source) + ": not a regular file");
+    DensityBuilder builder(layout, threshold, std::move(transform));
+    const uint64_t expected = builder.expectedBytes();
+    VoxelSource where = source;
+    if (source.encoding != VoxelSource::Encoding::Gzip) {
+        GzReader probe(source.path, labelOf(source), source.offset, source.encoding);
+        if (probe.direct()) {
+            where.offset = plainOffset(source, layout, expected);
+            where.skip = 0;
+            where.encoding = VoxelSource::Encoding::Raw;
+        }
+    }
+    GzReader reader(where.path, labelOf(where), where.offset, where.encoding);
+    streamInto(reader, where, layout, builder);
+    if (stats) *stats = builder.stats();
+    return builder.grid();
+}
+
 openvdb::FloatGrid::Ptr convertRaw(const std::string& path, const RawSpec& spec, RawStats* statsOut) {
     for (int d : spec.dims)
         if (d < 1 || d > kMaxRawDim) throw Error(path + ": dimensions must be in [1, " + std::to_string(kMaxRawDim) + "]");
-    const size_t rowBytes = size_t(spec.dims[0]) * rawTypeSize(spec.type);
-    const uint64_t expected = uint64_t(rowBytes) * uint64_t(spec.dims[1]) * uint64_t(spec.dims[2]);
-    checkVoxelLimit(spec);
-    GzReader reader(path);
-    if (reader.direct()) {
-        std::error_code ec;
-        const uint64_t size = std::filesystem::file_size(path, ec);
-        if (!ec && size != expected) throw Error(sizeMismatch(path, spec, expected, std::to_string(size)));
-    }
-    auto grid = openvdb::FloatGrid::create(0.0f);
-    grid->setName("density");
-    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-    grid->setTransform(openvdb::math::Transform::createLinearTransform(spec.spacing));
-    auto acc = grid->getAccessor();
-    RawStats stats;
-    const int rowsPerChunk = int(std::clamp<size_t>(kChunkBytes / rowBytes, 1, size_t(spec.dims[1])));
-    std::vector<unsigned char> buffer(rowBytes * rowsPerChunk);
-    for (int z = 0; z < spec.dims[2]; ++z) {
-        for (int y = 0; y < spec.dims[1]; y += rowsPerChunk) {
-            const int rows = std::min(rowsPerChunk, spec.dims[1] - y);
-            const size_t got = reader.read(buffer.data(), rows * rowBytes);
-            stats.bytes += got;
-            if (got < rows * rowBytes)
-                throw Error(sizeMismatch(path, spec, expected, "only " + std::to_string(stats.bytes) + " (too short)"));
-            addRows(buffer.data(), rows, y, z, spec, acc, stats);
-        }
-    }
-    if (const uint64_t extra = reader.countRest())
-        throw Error(sizeMismatch(path, spec, expected, std::to_string(expected + extra) + " (too long)"));
-    if (statsOut) *statsOut = stats;
-    return grid;
+    checkVoxelLimit(spec.dims, spec.maxVoxels, "--dims");
+    VoxelSource source;
+    source.path = path;
+    const VoxelLayout layout{spec.dims, spec.type, false};
+    return readVoxels(source, layout, spec.threshold, openvdb::math::Transform::createLinearTransform(spec.spacing),
+                      statsOut);
 }
 
 }  // namespace vdbsplat

@@ -218,6 +218,40 @@ TEST_F(Raw, MissingFileAndDirectory) {
               std::string::npos);
 }
 
+// The path every convert format shares (NRRD and VTI feed it bytes as they decode them).
+TEST(DensityBuilder, VoxelsSplitAcrossCallsBigEndianInt16AndFloat64) {
+    const auto unit = openvdb::math::Transform::createLinearTransform(1.0);
+    DensityBuilder u16({{3, 1, 1}, RawType::UInt16, true}, 0.0, unit);
+    const Bytes big{0x01, 0x00, 0xff, 0xff, 0x00, 0x02};  // 256, 65535, 2 (big-endian)
+    for (unsigned char b : big) u16.addBytes(&b, 1);       // one byte at a time: voxels split across calls
+    auto acc = u16.grid()->getConstAccessor();
+    EXPECT_FLOAT_EQ(acc.getValue(Coord(0, 0, 0)), 256.0f / 65535.0f);
+    EXPECT_FLOAT_EQ(acc.getValue(Coord(1, 0, 0)), 1.0f);
+    EXPECT_FLOAT_EQ(acc.getValue(Coord(2, 0, 0)), 2.0f / 65535.0f);
+    EXPECT_EQ(u16.bytes(), u16.expectedBytes());
+
+    DensityBuilder i16({{2, 2, 1}, RawType::Int16, false}, 0.0, unit);
+    const Bytes little{0xff, 0xff, 0xff, 0x7f, 0x00, 0x80, 0x01, 0x00};  // -1, 32767, -32768, 1
+    i16.addBytes(little.data(), little.size());
+    EXPECT_EQ(i16.stats().active, 2u);  // negatives are below the default threshold
+    EXPECT_FLOAT_EQ(i16.grid()->tree().getValue(Coord(1, 0, 0)), 1.0f);
+    EXPECT_FLOAT_EQ(i16.grid()->tree().getValue(Coord(1, 1, 0)), 1.0f / 32767.0f);
+
+    DensityBuilder f64({{3, 1, 1}, RawType::Float64, false}, 0.0, unit);
+    for (double v : {0.5, 1e300, 2.0}) {
+        const uint64_t bits = std::bit_cast<uint64_t>(v);
+        unsigned char b[8];
+        for (int k = 0; k < 8; ++k) b[k] = static_cast<unsigned char>(bits >> (8 * k));
+        f64.addBytes(b, 8);
+    }
+    EXPECT_EQ(f64.stats().nonFinite, 1u);  // beyond float32's range
+    EXPECT_EQ(f64.stats().active, 2u);
+    EXPECT_EQ(f64.grid()->tree().getValue(Coord(2, 0, 0)), 2.0f);
+    f64.addBytes(big.data(), big.size());  // bytes past the last voxel are counted, not added
+    EXPECT_EQ(f64.bytes(), f64.expectedBytes() + big.size());
+    EXPECT_EQ(f64.stats().active, 2u);
+}
+
 TEST(RawParse, DimsTypeAndSpacing) {
     EXPECT_EQ(parseDims("256,256,128", "--dims"), (std::array<int, 3>{256, 256, 128}));
     for (const char* bad : {"256,256", "1,2,3,4", "0,1,1", "a,b,c", "70000,1,1", "1,,1", "1.5,2,3", ""}) {
@@ -230,6 +264,8 @@ TEST(RawParse, DimsTypeAndSpacing) {
     }
     EXPECT_EQ(parseRawType("uint16", "--type"), RawType::UInt16);
     EXPECT_THROW(parseRawType("int8", "--type"), Error);
+    EXPECT_EQ(parseRawType("int16", "--type"), RawType::Int16);
+    EXPECT_EQ(parseRawType("float64", "--type"), RawType::Float64);
     EXPECT_EQ(parseUniformSpacing("0.5,0.5,0.5", "--spacing"), 0.5);
     try {
         parseUniformSpacing("1,1,1.4", "--spacing");
