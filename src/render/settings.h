@@ -20,6 +20,22 @@ enum class RenderMode { Reference, Hybrid, Splat, Point };
 ///   Exact — every splat by the closed-form per-pixel footprint (to measure the others).
 enum class FootprintPath { Table, Auto, Exact };
 
+/// Where the screen low-pass h_p (the prefilter, DESIGN §1) is applied in the forward modes:
+///   Prefilter  — EWA (Zwicker et al. 2001): each primitive's optical depth is convolved with
+///                h_p, then composited. exp(−h_p∗τ) ≠ h_p∗exp(−τ) (Jensen), so structures
+///                one or two pixels wide come out too opaque (DESIGN §8.3).
+///   Postfilter — composite on a sub-pixel grid (--subpixels k per axis) whose primitives carry
+///                only a small low-pass, then convolve the composited image with the rest of
+///                h_p and sample at pixel centres: the order the reference uses (docs/fidelity.md).
+enum class FilterOrder { Prefilter, Postfilter };
+
+/// @throw Error "--filter-order: expected 'prefilter' or 'postfilter', got '<name>'".
+FilterOrder parseFilterOrder(const std::string& name);
+std::string toString(FilterOrder order);
+
+/// Postfilter: sub-pixels per axis by default and the most --subpixels accepts.
+inline constexpr int kDefaultSubpixels = 2, kMaxSubpixels = 8;
+
 /// @throw Error "--footprint: expected 'auto', 'table' or 'exact', got '<name>'".
 FootprintPath parseFootprintPath(const std::string& name);
 std::string toString(FootprintPath path);
@@ -46,6 +62,8 @@ struct RenderSettings {
     int spp = 16;                           ///< reference: rays per pixel (rounded to a square)
     double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
     FootprintPath footprint = FootprintPath::Auto;
+    FilterOrder filterOrder = FilterOrder::Postfilter;
+    int subpixels = kDefaultSubpixels;      ///< Postfilter: sub-pixel grid per axis
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
     /// Level of detail for minified voxels (DESIGN §8.2): points are aggregated over cells of
     /// 2, 4 or 8 voxels per side whose side projects to at most this many pixels; 0: off.
