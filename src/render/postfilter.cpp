@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <numbers>
 
 #include "footprint/prefilter.h"
@@ -19,9 +18,7 @@ SubpixelGrid makeSubpixelGrid(int k, double prefilterVariance) {
     SubpixelGrid g;
     g.k = k;
     // V_s/k² may not exceed V_h: keep at least a quarter of the low-pass for the image.
-    double vs = kSubpixelPrefilterVariance;
-    if (const char* e = std::getenv("VDBSPLAT_TMP_VS")) vs = std::atof(e);  // TEMPORARY: measuring
-    g.fineVariance = std::min(vs, 0.75 * prefilterVariance * k * k);
+    g.fineVariance = std::min(kSubpixelPrefilterVariance, 0.75 * prefilterVariance * k * k);
     g.postVariance = prefilterVariance - g.fineVariance / (double(k) * k);
     g.border = int(std::ceil(kPrefilterCutoffSigmas * std::sqrt(g.postVariance)));
     return g;

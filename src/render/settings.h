@@ -24,9 +24,10 @@ enum class FootprintPath { Table, Auto, Exact };
 ///   Prefilter  — EWA (Zwicker et al. 2001): each primitive's optical depth is convolved with
 ///                h_p, then composited. exp(−h_p∗τ) ≠ h_p∗exp(−τ) (Jensen), so structures
 ///                one or two pixels wide come out too opaque (DESIGN §8.3).
-///   Postfilter — composite on a sub-pixel grid (--subpixels k per axis) whose primitives carry
-///                only a small low-pass, then convolve the composited image with the rest of
-///                h_p and sample at pixel centres: the order the reference uses (docs/fidelity.md).
+///   Postfilter — composite on a grid of k sub-pixels per pixel and axis (--subpixels, default
+///                1: the pixel grid itself) whose primitives carry only a small low-pass, then
+///                convolve the composited image with the rest of h_p and sample at pixel
+///                centres: the order the reference uses (render/postfilter.h).
 enum class FilterOrder { Prefilter, Postfilter };
 
 /// @throw Error "--filter-order: expected 'prefilter' or 'postfilter', got '<name>'".
@@ -34,7 +35,9 @@ FilterOrder parseFilterOrder(const std::string& name);
 std::string toString(FilterOrder order);
 
 /// Postfilter: sub-pixels per axis by default and the most --subpixels accepts.
-inline constexpr int kDefaultSubpixels = 2, kMaxSubpixels = 8;
+/// k = 1 with a small V_s already reaches 45–60 dB on the tubes at the cost of the prefilter
+/// order; k = 2 adds 0–6 dB for 2–3.5× the time at close views (docs/performance.md).
+inline constexpr int kDefaultSubpixels = 1, kMaxSubpixels = 8;
 
 /// @throw Error "--footprint: expected 'auto', 'table' or 'exact', got '<name>'".
 FootprintPath parseFootprintPath(const std::string& name);

@@ -9,6 +9,7 @@
 #include "camera/camera.h"
 #include "footprint/prefilter.h"
 #include "render/postfilter.h"
+#include "render/settings.h"
 
 namespace vdbsplat {
 namespace {

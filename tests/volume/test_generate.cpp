@@ -179,7 +179,10 @@ TEST(Generate, TubesFollowTheirLayout) {
             const Coord c(int(std::lround(p.x())), int(std::lround(p.y())), int(std::lround(p.z())));
             EXPECT_TRUE(acc.isValueOn(c)) << c;
             EXPECT_GT(acc.getValue(c), 0.25f) << c;  // ≤ √3/2 voxel from the axis
-            if (tubeDistance(t, openvdb::Vec3d(c.x(), c.y(), c.z())) <= t.r) EXPECT_EQ(acc.getValue(c), 1.0f), ++onAxis;
+            if (tubeDistance(t, openvdb::Vec3d(c.x(), c.y(), c.z())) <= t.r) {
+                EXPECT_EQ(acc.getValue(c), 1.0f) << c;
+                ++onAxis;
+            }
         }
     }
     EXPECT_GT(onAxis, 0);
