@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The fidelity table of docs/fidelity.md: PSNR/SSIM of hybrid, splat and point against the
-# reference renderer for the checker box, Marschner-Lobb and the converted Engine at the
-# three standard views (--distance 8, 1, 0.35), 400x400. The volumes come from volumes/
+# reference renderer for the checker box, Marschner-Lobb, the converted Engine and the tubes at
+# the three standard views (--distance 8, 1, 0.35), 400x400, with the default filter order
+# (postfilter) and with --filter-order prefilter (EWA's order, the default before issue 10). The volumes come from volumes/
 # (volumes/README.md): the generated ones are made there when missing, the Engine is
 # volumes/engine.vdb from volumes/fetch.sh (its rows are skipped when it is absent).
 # Reference images are cached in out/fidelity/ (delete them to re-render).
@@ -17,14 +18,15 @@ OUT=out/fidelity
 VOLS=volumes
 mkdir -p "$OUT"
 
-for vol in checkerbox marschner-lobb; do
+for vol in checkerbox marschner-lobb tubes; do
   [[ -f $VOLS/$vol.vdb ]] || VDBSPLAT=$BIN volumes/make-generated.sh $vol >/dev/null
 done
 VOLUMES="checkerbox:grey marschner-lobb:grey"
 if [[ -f $VOLS/engine.vdb ]]; then
-  VOLUMES="$VOLUMES engine:ct-bone"
+  VOLUMES="$VOLUMES engine:ct-bone tubes:grey"
 else
   echo "fidelity: $VOLS/engine.vdb absent (run volumes/fetch.sh engine), skipping the Engine rows" >&2
+  VOLUMES="$VOLUMES tubes:grey"
 fi
 
 printf "volume\tdistance\tmode\tpsnr_db\tssim\tsplat_pct\tseconds\n" > $OUT/fidelity.tsv
@@ -36,9 +38,12 @@ for entry in $VOLUMES; do
       "$BIN" render $VOLS/$vol.vdb -o $ref --mode reference --tf $tf --distance $d --spp $SPP \
           --stats $OUT/${vol}_d${d}_reference.json
     fi
-    for mode in hybrid splat point; do
+    for mode in hybrid splat point hybrid-prefilter splat-prefilter point-prefilter; do
       img=$OUT/${vol}_d${d}_${mode}.exr
-      "$BIN" render $VOLS/$vol.vdb -o $img --mode $mode --tf $tf --distance $d --stats $OUT/stats.json
+      order=postfilter
+      [[ $mode == *-prefilter ]] && order=prefilter
+      "$BIN" render $VOLS/$vol.vdb -o $img --mode ${mode%-prefilter} --filter-order $order --tf $tf --distance $d \
+          --stats $OUT/stats.json
       m=$("$BIN" compare $img $ref)
       psnr=$(sed -E 's/.*psnr=([^ ]+) dB.*/\1/' <<<"$m")
       ssim=$(sed -E 's/.*ssim=([^ ]+) .*/\1/' <<<"$m")
@@ -51,15 +56,18 @@ for entry in $VOLUMES; do
   done
 done
 
-# Markdown: one row per volume and view, PSNR (dB) of each mode, % splats of the hybrid.
+# Markdown: one row per volume and view, PSNR (dB) of each mode, % splats of the hybrid, then
+# the same modes with --filter-order prefilter.
 {
-  echo "| volume | view | hybrid | splat | point | hybrid % splats |"
-  echo "|---|---|---|---|---|---|"
+  echo "| volume | view | hybrid | splat | point | hybrid % splats | hybrid, prefilter | splat, prefilter | point, prefilter |"
+  echo "|---|---|---|---|---|---|---|---|---|"
   awk -F'\t' 'NR > 1 { key = $1 "|" $2; psnr[key, $3] = $4; if ($3 == "hybrid") pct[key] = $6;
                         if (!(key in seen)) { seen[key] = 1; order[n++] = key } }
               END { for (i = 0; i < n; ++i) { split(order[i], k, "|");
-                      printf "| %s | --distance %s | %s | %s | %s | %s |\n", k[1], k[2],
-                             psnr[order[i], "hybrid"], psnr[order[i], "splat"], psnr[order[i], "point"], pct[order[i]] } }' \
+                      printf "| %s | --distance %s | %s | %s | %s | %s | %s | %s | %s |\n", k[1], k[2],
+                             psnr[order[i], "hybrid"], psnr[order[i], "splat"], psnr[order[i], "point"], pct[order[i]],
+                             psnr[order[i], "hybrid-prefilter"], psnr[order[i], "splat-prefilter"],
+                             psnr[order[i], "point-prefilter"] } }' \
       $OUT/fidelity.tsv
 } > $OUT/fidelity.md
 cat $OUT/fidelity.md

@@ -3,7 +3,7 @@
 # the docs use, through `vdbsplat generate`, and checks each one's active voxel count.
 #
 # usage: volumes/make-generated.sh [--out DIR] [NAME... | all]
-#   NAME       checkerbox, marschner-lobb, sphere, cloud (no NAME or "all": these four),
+#   NAME       checkerbox, marschner-lobb, sphere, cloud, tubes (no NAME or "all": these five),
 #              cloud-20m, cloud-100m (the large grids of docs/performance.md, only when
 #              named: 66 MB and 314 MB files)
 #   --out DIR  where the .vdb files go (default: volumes/)
@@ -16,13 +16,14 @@ ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 die() { echo "make-generated: error: $*" >&2; exit 1; }
 
 # --- The catalogue: name, `vdbsplat generate` arguments, active voxels -------------------------
-STANDARD=(checkerbox marschner-lobb sphere cloud)
+STANDARD=(checkerbox marschner-lobb sphere cloud tubes)
 LARGE=(cloud-20m cloud-100m)
 declare -A ARGS=(
   [checkerbox]="checkerbox --res 100"
   [marschner-lobb]="marschner-lobb --res 41"
   [sphere]="sphere --res 64"
   [cloud]="cloud --active 1000000 --seed 1"
+  [tubes]="tubes --res 128 --count 14 --sheets 2 --radius-min 0.7 --radius-max 2.5 --seed 1"
   [cloud-20m]="cloud --active 20000000 --seed 1"
   [cloud-100m]="cloud --active 100000000 --seed 1"
 )
@@ -31,6 +32,7 @@ declare -A ACTIVE=(
   [marschner-lobb]=68921
   [sphere]=130536
   [cloud]=1000002
+  [tubes]=34740
   [cloud-20m]=19999990
   [cloud-100m]=99999970
 )

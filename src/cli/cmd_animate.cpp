@@ -97,6 +97,7 @@ const char* kHelp =
     "  --lod PX           level-of-detail cell size in pixels (default 1; 0: off; see render --help)\n"
     "  --simd on|off      splats through the vector loop (default on) or the scalar table path\n"
     "  --footprint P      auto (default) | table | exact (see render --help)\n"
+    "  --filter-order O   postfilter (default) | prefilter; --subpixels K (see render --help)\n"
     "  --show-primitives  tint splats red\n"
     "  --tables DIR       footprint and reindex tables (see render --help)\n"
     "  --spp N            reference rays per pixel (default 16, rounded up to a square)\n"

@@ -24,6 +24,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/render_flags.h"
 #include "render/render.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -58,6 +59,7 @@ const char* kHelp =
     "  --lod PX             level-of-detail cell size in pixels (default 1; 0: off; see render --help)\n"
     "  --simd on|off        vector splat loop (default on) or the scalar table path\n"
     "  --footprint P        auto (default) | table | exact (see render --help)\n"
+    "  --filter-order O     postfilter (default) | prefilter; --subpixels K (see render --help)\n"
     "  --json FILE.json     also write every run, the per-stage medians and the ratios as JSON\n"
     "  -v                   print each run to stderr and the per-stage medians to stdout\n";
 
@@ -140,6 +142,7 @@ Options optionsFrom(const Args& args) {
     if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
+    applyFilterFlags(args, s);
     if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
     if (auto v = args.get("--simd")) {
         if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
@@ -211,7 +214,7 @@ std::string formatDistance(double d) {
 int runBench(const Argv& argv) {
     const Args args(argv,
                     {"--grid", "--tf", "--size", "--runs", "--warmup", "--threads", "--modes", "--distances",
-                     "--threshold", "--lod", "--simd", "--footprint", "--json", "--view-dir", "--up"},
+                     "--threshold", "--lod", "--simd", "--footprint", "--filter-order", "--subpixels", "--json", "--view-dir", "--up"},
                     {"-v"});
     if (args.wantsHelp()) {
         std::cout << kHelp;
@@ -285,10 +288,10 @@ int runBench(const Argv& argv) {
     }
 
     // The table.
-    std::printf("vdbsplat bench: %s (grid '%s', %llu active voxels), %dx%d, tf %s, threshold %g px, footprint %s\n",
+    std::printf("vdbsplat bench: %s (grid '%s', %llu active voxels), %dx%d, tf %s, threshold %g px, footprint %s, %s (%d subpixels)\n",
                 o.input.c_str(), volume.name.c_str(), (unsigned long long)volume.activeVoxels, o.base.camera.width,
                 o.base.camera.height, o.base.transferFunction.c_str(), o.base.threshold,
-                toString(o.base.footprint).c_str());
+                toString(o.base.footprint).c_str(), toString(o.base.filterOrder).c_str(), o.base.subpixels);
     std::printf("threads %d (machine %u), %d timed run%s + %d warmup per view and mode, interleaved\n\n", threads,
                 machine, o.runs, o.runs == 1 ? "" : "s", o.warmup);
     std::printf("%8s  %-9s  %9s  %9s  %8s  %15s  %10s  %10s  %10s\n", "distance", "mode", "median_s", "min_s", "%splats",
@@ -337,6 +340,8 @@ int runBench(const Argv& argv) {
         j["tf"] = o.base.transferFunction;
         j["threshold"] = o.base.threshold;
         j["footprint"] = toString(o.base.footprint);
+        j["filter_order"] = toString(o.base.filterOrder);
+        j["subpixels"] = o.base.subpixels;
         j["fov"] = o.base.camera.fovDeg;
         nlohmann::ordered_json results = nlohmann::ordered_json::array();
         for (const Cell& c : cells) {

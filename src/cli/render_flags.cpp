@@ -10,7 +10,7 @@ const std::set<std::string>& renderValueFlags() {
     static const std::set<std::string> flags{"--grid",   "--mode",      "--size",      "--tf",    "--eye",
                                              "--look-at", "--up",       "--view-dir",  "--fov",   "--distance",
                                              "--threads", "--spp",      "--threshold", "--lod",   "--footprint",
-                                             "--tables",  "--simd", "--max-voxels"};
+                                             "--tables",  "--simd", "--max-voxels", "--filter-order", "--subpixels"};
     return flags;
 }
 
@@ -33,6 +33,7 @@ RenderSettings settingsFromFlags(const Args& args) {
     if (auto v = args.get("--max-voxels"))
         s.maxActiveVoxels = uint64_t(parseInt(*v, "--max-voxels", 1, (long long)kHardMaxActiveVoxels));
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
+    applyFilterFlags(args, s);
     if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
     if (auto v = args.get("--simd")) {
         if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
@@ -56,6 +57,11 @@ RenderSettings settingsFromFlags(const Args& args) {
     }
     s.validate();
     return s;
+}
+
+void applyFilterFlags(const Args& args, RenderSettings& s) {
+    if (auto v = args.get("--filter-order")) s.filterOrder = parseFilterOrder(*v);
+    if (auto v = args.get("--subpixels")) s.subpixels = int(parseInt(*v, "--subpixels", 1, kMaxSubpixels));
 }
 
 void resolveLookAt(const Args& args, const Volume& volume, RenderSettings& settings) {

@@ -1,6 +1,6 @@
 // cli/render_flags.h — the render flags shared by `vdbsplat render` and `vdbsplat animate`.
 // Owns: turning --mode, --size, --tf, --grid, --fov, --distance, --threads, --spp,
-// --threshold, --footprint, --lod, --simd, --show-primitives, --tables, --up, --view-dir, --eye and
+// --threshold, --footprint, --filter-order, --subpixels, --lod, --simd, --show-primitives, --tables, --up, --view-dir, --eye and
 // --look-at into validated RenderSettings, the same way for every command that renders
 // (a command that does not declare a flag never sees it: Args refuses it first).
 #pragma once
@@ -25,6 +25,10 @@ glm::dvec3 parseVec3(const std::string& text, const std::string& flag);
 /// --eye's look-at is resolved after the volume is loaded (resolveLookAt).
 /// @throw Error naming the first bad flag.
 RenderSettings settingsFromFlags(const Args& args);
+
+/// @brief --filter-order and --subpixels into @p s (render, animate and bench share it).
+/// @throw Error naming the flag.
+void applyFilterFlags(const Args& args, RenderSettings& s);
 
 /// @brief With --eye: the look-at from --look-at, or the centre of @p volume's bounds.
 void resolveLookAt(const Args& args, const Volume& volume, RenderSettings& settings);

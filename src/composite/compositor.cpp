@@ -314,7 +314,7 @@ void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
     // Ellipse, and then takes the half-ray fallback like a NearEye kernel.
     const bool widened = p.kind != PrimitiveKind::NearEye && sphere.isEllipse();
     ScreenKernel kernel;
-    if (widened) kernel = makeScreenKernel(sphere);
+    if (widened) kernel = makeScreenKernel(sphere, exact_.prefilterVariance);
     const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
     const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
     const double sigmaWorld = p.sigma / h;

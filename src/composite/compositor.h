@@ -18,6 +18,7 @@
 
 #include "composite/primitive.h"
 #include "footprint/ellipse.h"
+#include "footprint/prefilter.h"
 #include "footprint/tables.h"
 #include "image/image.h"
 #include "pointfilter/point_filter.h"
@@ -35,6 +36,8 @@ struct ExactContext {
     /// Splats through the vector loop (composite/splat_raster.h, polynomial footprint); false:
     /// the scalar table path, the oracle it is tested against.
     bool vector = true;
+    /// The low-pass folded into kernels recomputed per tile (px²; as ProjectionContext).
+    double prefilterVariance = kPrefilterVariance;
 };
 
 /// Primitives composite() dropped because every tile they touch is already opaque.

@@ -10,9 +10,9 @@
 
 namespace vdbsplat {
 
-double pointFilterVariance(double projectedSpacingPx) {
+double pointFilterVariance(double projectedSpacingPx, double prefilterVariance) {
     const double s = Kernel::kSigma * projectedSpacingPx;
-    return kPrefilterVariance + s * s;
+    return prefilterVariance + s * s;
 }
 
 double pointDepositTotal(double sigma, double h, double f, const ViewPoint& c) {

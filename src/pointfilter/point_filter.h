@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "camera/camera.h"
+#include "footprint/prefilter.h"
 
 namespace vdbsplat {
 
@@ -29,7 +30,8 @@ inline constexpr int kPointMaxSide = 7;             ///< 2·kPointMaxRadiusPx
 
 /// @brief V_point = kPrefilterVariance + (s_g·@p projectedSpacingPx)² in px², where the
 /// projected voxel spacing is h·f/z pixels (DESIGN §4).
-double pointFilterVariance(double projectedSpacingPx);
+/// @param prefilterVariance the low-pass V_h in px² (the postfilter order passes a smaller one).
+double pointFilterVariance(double projectedSpacingPx, double prefilterVariance = kPrefilterVariance);
 
 /// @brief The point's total optical depth summed over pixels (DESIGN §4):
 ///     σ · M · (f/z)² · (D/z),   M = h³ (the kernel's volume integral in world units).

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "composite/compositor.h"
+#include "render/postfilter.h"
 #include "render/project.h"
 #include "volume/stream.h"
 
@@ -14,20 +15,29 @@ namespace vdbsplat {
 namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-}  // namespace
 
-Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
-                    const Tables& tables, const RenderSettings& settings, RenderStats& stats,
-                    const RenderControl& control) {
+/// What the forward pipeline draws with, in the pixels of the image it composites on.
+struct ForwardPass {
+    double threshold;          ///< τ (px): projected voxel spacing below which voxels are points
+    double lodPx;              ///< level-of-detail cell size (px)
+    double prefilterVariance;  ///< V_h folded into each primitive (px²)
+};
+
+/// Streams, projects and composites @p volume onto @p camera's pixels.
+Image composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, const Tables& tables,
+                const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
+                const RenderControl& control) {
     StreamOptions streamOptions = settings.stream;
-    streamOptions.lodCellPx = settings.lodPx;
+    streamOptions.lodCellPx = pass.lodPx;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point   ? INFINITY
                                  : settings.mode == RenderMode::Splat ? 0.0
-                                                                      : settings.threshold;
+                                                                      : pass.threshold;
     VoxelStream stream(volume, camera, table, streamOptions);
-    TileCompositor compositor(camera.width(), camera.height(), tables, ExactContext{&camera, volume.voxelSize, settings.simd});
-    const ProjectionContext ctx{camera,          tables,           volume.voxelSize,  stream.slabLength(),
-                                settings.mode,   settings.threshold, settings.footprint, settings.showPrimitives};
+    TileCompositor compositor(camera.width(), camera.height(), tables,
+                              ExactContext{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance});
+    const ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
+                                settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
+                                pass.prefilterVariance};
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
     std::vector<Primitive> prims;
@@ -65,6 +75,25 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     stats.windows = stream.windows();
     stats.largestWindow = stream.largestWindow();
     return compositor.image();
+}
+
+}  // namespace
+
+Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
+                    const Tables& tables, const RenderSettings& settings, RenderStats& stats,
+                    const RenderControl& control) {
+    if (settings.filterOrder == FilterOrder::Prefilter)
+        return composite(volume, table, camera, tables, settings,
+                         ForwardPass{settings.threshold, settings.lodPx, kPrefilterVariance}, stats, control);
+    // Postfilter: the same primitives (τ and the level of detail scaled to sub-pixels, so the
+    // same voxels are points), composited at k× the resolution with only V_s folded in, then
+    // the rest of the low-pass on the composited image (postfilter.h).
+    const SubpixelGrid grid = makeSubpixelGrid(settings.subpixels, kPrefilterVariance);
+    const Camera fine = subpixelCamera(camera, grid);
+    const double k = grid.k;
+    const Image sub = composite(volume, table, fine, tables, settings,
+                                ForwardPass{settings.threshold * k, settings.lodPx * k, grid.fineVariance}, stats, control);
+    return postfilterImage(sub, grid, camera.width(), camera.height());
 }
 
 }  // namespace vdbsplat

@@ -27,7 +27,7 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float sp
     if (!std::isfinite(centre.x) || !std::isfinite(centre.y)) return p;
     p.kind = PrimitiveKind::Point;
     p.centre = glm::vec2(centre);
-    p.variance = float(pointFilterVariance(spacingPx) + spreadPx2);  // + an aggregate's spread (DESIGN §8.2)
+    p.variance = float(pointFilterVariance(spacingPx, ctx.prefilterVariance) + spreadPx2);  // + an aggregate's spread (DESIGN §8.2)
     // σ·M·(f/z)²·(D/z) with σ per world unit = sigma / h (DESIGN §4).
     p.total = float(pointDepositTotal(sigma / ctx.voxelSize, ctx.voxelSize, ctx.camera.focal(), c));
     PixelBox box;
@@ -52,7 +52,7 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
             p.range = pixelRange(sphere.bounds, ctx.camera.width(), ctx.camera.height());
             break;
         case SphereClass::Ellipse: {
-            const ScreenKernel kernel = makeScreenKernel(sphere);
+            const ScreenKernel kernel = makeScreenKernel(sphere, ctx.prefilterVariance);
             p.kind = ctx.footprint == FootprintPath::Exact ? PrimitiveKind::SplatExact
                      : ctx.footprint == FootprintPath::Auto && sphere.affineIndexError() > kAutoExactIndexError
                          ? PrimitiveKind::SplatExactIndex

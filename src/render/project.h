@@ -10,6 +10,7 @@
 
 #include "camera/camera.h"
 #include "composite/primitive.h"
+#include "footprint/prefilter.h"
 #include "footprint/tables.h"
 #include "render/settings.h"
 #include "volume/stream.h"
@@ -30,6 +31,9 @@ struct ProjectionContext {
     double threshold;     ///< τ in pixels
     FootprintPath footprint;
     bool showPrimitives;
+    /// The screen low-pass V_h folded into every primitive (px²): kPrefilterVariance, or the
+    /// sub-pixel grid's small one when the prefilter is applied after compositing (postfilter.h).
+    double prefilterVariance = kPrefilterVariance;
 };
 
 /// @brief Projects every voxel of @p batch into the first batch.size() elements of @p prims

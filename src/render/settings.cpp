@@ -38,6 +38,8 @@ void RenderSettings::validate() const {
     if (!(std::isfinite(threshold) && threshold > 0.0)) throw Error("--threshold: must be a positive number of pixels");
     if (!(std::isfinite(lodPx) && lodPx >= 0.0 && lodPx <= 64.0))
         throw Error("--lod: must be a number of pixels in [0, 64] (0 turns level of detail off)");
+    if (subpixels < 1 || subpixels > kMaxSubpixels)
+        throw Error("--subpixels: must be in [1, " + std::to_string(kMaxSubpixels) + "]");
     if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
         throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
     if (!tablesDir.empty()) {
@@ -64,6 +66,14 @@ std::string toString(FootprintPath path) {
     return "?";
 }
 
+FilterOrder parseFilterOrder(const std::string& name) {
+    if (name == "prefilter") return FilterOrder::Prefilter;
+    if (name == "postfilter") return FilterOrder::Postfilter;
+    throw Error("--filter-order: expected 'prefilter' or 'postfilter', got '" + name + "'");
+}
+
+std::string toString(FilterOrder order) { return order == FilterOrder::Prefilter ? "prefilter" : "postfilter"; }
+
 nlohmann::json RenderSettings::toJson() const {
     nlohmann::json j;
     j["mode"] = toString(mode);
@@ -86,6 +96,8 @@ nlohmann::json RenderSettings::toJson() const {
     j["spp"] = spp;
     j["threshold"] = threshold;
     j["footprint"] = toString(footprint);
+    j["filter_order"] = toString(filterOrder);
+    j["subpixels"] = subpixels;
     j["show_primitives"] = showPrimitives;
     j["lod"] = lodPx;
     j["simd"] = simd;

@@ -22,6 +22,25 @@ enum class RenderMode { Reference, Hybrid, Splat, Point };
 ///   Exact — every splat by the closed-form per-pixel footprint (to measure the others).
 enum class FootprintPath { Table, Auto, Exact };
 
+/// Where the screen low-pass h_p (the prefilter, DESIGN §1) is applied in the forward modes:
+///   Prefilter  — EWA (Zwicker et al. 2001): each primitive's optical depth is convolved with
+///                h_p, then composited. exp(−h_p∗τ) ≠ h_p∗exp(−τ) (Jensen), so structures
+///                one or two pixels wide come out too opaque (DESIGN §8.3).
+///   Postfilter — composite on a grid of k sub-pixels per pixel and axis (--subpixels, default
+///                1: the pixel grid itself) whose primitives carry only a small low-pass, then
+///                convolve the composited image with the rest of h_p and sample at pixel
+///                centres: the order the reference uses (render/postfilter.h).
+enum class FilterOrder { Prefilter, Postfilter };
+
+/// @throw Error "--filter-order: expected 'prefilter' or 'postfilter', got '<name>'".
+FilterOrder parseFilterOrder(const std::string& name);
+std::string toString(FilterOrder order);
+
+/// Postfilter: sub-pixels per axis by default and the most --subpixels accepts.
+/// k = 1 with a small V_s already reaches 45–60 dB on the tubes at the cost of the prefilter
+/// order; k = 2 adds 0–6 dB for 2–3.5× the time at close views (docs/performance.md).
+inline constexpr int kDefaultSubpixels = 1, kMaxSubpixels = 8;
+
 /// @throw Error "--footprint: expected 'auto', 'table' or 'exact', got '<name>'".
 FootprintPath parseFootprintPath(const std::string& name);
 std::string toString(FootprintPath path);
@@ -48,6 +67,8 @@ struct RenderSettings {
     int spp = 16;                           ///< reference: rays per pixel (rounded to a square)
     double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
     FootprintPath footprint = FootprintPath::Auto;
+    FilterOrder filterOrder = FilterOrder::Postfilter;
+    int subpixels = kDefaultSubpixels;      ///< Postfilter: sub-pixel grid per axis
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
     /// Level of detail for minified voxels (DESIGN §8.2): points are aggregated over cells of
     /// 2, 4 or 8 voxels per side whose side projects to at most this many pixels; 0: off.

@@ -2,7 +2,8 @@
 // Owns the leaf-parallel grid builder and the four generators: Yuan et al. 2003's
 // Checker Box, Marschner & Lobb 1994's test signal (their eq. 1 with f_M = 6, α = 0.25),
 // a smooth fog ball, and a hash-based fractal value-noise cloud whose threshold is
-// chosen from a histogram so that the active count is close to the request.
+// chosen from a histogram so that the active count is close to the request, and random thin
+// tubes and sheets (capsules along quadratic Bézier axes, discs), seeded.
 #include "volume/generate.h"
 
 #include <tbb/blocked_range.h>
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <cstdio>
 #include <numbers>
 
 #include "util/error.h"
@@ -335,23 +337,106 @@ void cutCandidates(openvdb::FloatTree& tree, double threshold, double width) {
     openvdb::tools::pruneInactive(tree);
 }
 
+
+// ---------------------------------------------------------------------------
+// Tubes: counter-based random numbers (splitmix64 of seed and index), a fixed
+// layout, then every leaf evaluates only the capsule segments and discs whose
+// bounding boxes touch it.
+// ---------------------------------------------------------------------------
+
+constexpr int kTubeSegments = 32;          ///< polyline segments per Bézier axis
+constexpr double kTubeMarginFraction = 0.06;  ///< endpoints stay this far (× res) inside the box
+constexpr double kTubeMinLengthFraction = 0.6;  ///< endpoints at least this far apart (× res)
+constexpr double kTubeBendFraction = 0.2;  ///< control point offset from the midpoint, up to ± this × res
+constexpr double kSheetExtentMin = 0.06, kSheetExtentMax = 0.10;  ///< disc radius (× res)
+
+/// Uniform [0, 1) from (seed, stream, index): the layout does not depend on evaluation order.
+double uniform01(uint64_t seed, uint64_t stream, uint64_t index) {
+    const uint64_t h = mix64(mix64(seed ^ 0xA0761D6478BD642Full) ^ (stream * 0xE7037ED1A0B428DBull) ^ index);
+    return double(h >> 11) * (1.0 / 9007199254740992.0);
+}
+
+openvdb::Vec3d bezier(const TubePrimitive& t, double u) {
+    return (1.0 - u) * (1.0 - u) * t.a + 2.0 * u * (1.0 - u) * t.m + u * u * t.b;
+}
+
+double segmentDistance(const openvdb::Vec3d& p0, const openvdb::Vec3d& p1, const openvdb::Vec3d& x) {
+    const openvdb::Vec3d d = p1 - p0;
+    const double len2 = d.lengthSqr();
+    const double u = len2 > 0.0 ? std::clamp((x - p0).dot(d) / len2, 0.0, 1.0) : 0.0;
+    return (x - (p0 + u * d)).length();
+}
+
+/// What a leaf evaluates: one capsule segment of a tube (sheet = false) or one disc.
+struct TubePiece {
+    const TubePrimitive* owner;
+    openvdb::Vec3d p0, p1;  ///< segment ends (tubes)
+    CoordBBox box;          ///< voxels where its density may be > 0
+};
+
+CoordBBox pieceBox(openvdb::Vec3d lo, openvdb::Vec3d hi, double pad) {
+    return CoordBBox(Coord(int(std::floor(lo.x() - pad)), int(std::floor(lo.y() - pad)), int(std::floor(lo.z() - pad))),
+                     Coord(int(std::ceil(hi.x() + pad)), int(std::ceil(hi.y() + pad)), int(std::ceil(hi.z() + pad))));
+}
+
+std::vector<TubePiece> tubePieces(const std::vector<TubePrimitive>& layout) {
+    std::vector<TubePiece> pieces;
+    for (const TubePrimitive& t : layout) {
+        const double pad = t.r + kTubeFalloffVoxels;
+        if (t.sheet) {
+            const openvdb::Vec3d e(t.extent);
+            pieces.push_back({&t, t.a, t.a, pieceBox(t.a - e, t.a + e, pad)});
+            continue;
+        }
+        for (int k = 0; k < kTubeSegments; ++k) {
+            const openvdb::Vec3d p0 = bezier(t, double(k) / kTubeSegments), p1 = bezier(t, double(k + 1) / kTubeSegments);
+            pieces.push_back({&t, p0, p1, pieceBox(minComponent(p0, p1), maxComponent(p0, p1), pad)});
+        }
+    }
+    return pieces;
+}
+
+double pieceDistance(const TubePiece& p, const openvdb::Vec3d& x) {
+    return p.owner->sheet ? tubeDistance(*p.owner, x) : segmentDistance(p.p0, p.p1, x);
+}
+
+std::unique_ptr<LeafT> buildTubeLeaf(const std::vector<TubePiece>& pieces, const Coord& origin, const CoordBBox& domain) {
+    const CoordBBox leafBox(origin, origin + Coord(7));
+    std::vector<const TubePiece*> near;
+    for (const TubePiece& p : pieces)
+        if (p.box.hasOverlap(leafBox)) near.push_back(&p);
+    if (near.empty()) return nullptr;
+    return buildLeaf(origin, domain, [&](const Coord& c, float& v) {
+        const openvdb::Vec3d x(c.x(), c.y(), c.z());
+        double best = 0.0;
+        for (const TubePiece* p : near)
+            if (p->box.isInside(c)) best = std::max(best, tubeProfile(pieceDistance(*p, x), p->owner->r));
+        v = static_cast<float>(best);
+        return v > 0.0f;
+    });
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
 
 const std::vector<std::string>& generatorKinds() {
-    static const std::vector<std::string> kinds{"checkerbox", "marschner-lobb", "sphere", "cloud"};
+    static const std::vector<std::string> kinds{"checkerbox", "marschner-lobb", "sphere", "cloud", "tubes"};
     return kinds;
 }
 
 void GenerateOptions::validate() {
     const auto& kinds = generatorKinds();
     if (std::find(kinds.begin(), kinds.end(), kind) == kinds.end())
-        throw Error("generate: unknown kind '" + kind + "' (choose checkerbox, marschner-lobb, sphere or cloud)");
-    const bool cloud = kind == "cloud";
+        throw Error("generate: unknown kind '" + kind + "' (choose checkerbox, marschner-lobb, sphere, cloud or tubes)");
+    const bool cloud = kind == "cloud", tubes = kind == "tubes";
     if (cloud && res) throw Error("--res: not used by 'cloud' (its size follows --active)");
     if (!cloud && active) throw Error("--active: only 'cloud' takes an active voxel count");
-    if (!cloud && seed) throw Error("--seed: only 'cloud' is random");
+    if (!cloud && !tubes && seed) throw Error("--seed: only 'cloud' and 'tubes' are random");
+    if (!tubes && count) throw Error("--count: only 'tubes' takes a tube count");
+    if (!tubes && sheets) throw Error("--sheets: only 'tubes' takes a sheet count");
+    if (!tubes && (radiusMin || radiusMax)) throw Error("--radius-min/--radius-max: only 'tubes' takes a radius");
+    if (tubes) validateTubes();
     if (cloud) {
         if (!active) active = kDefaultCloudActive;
         if (!seed) seed = kDefaultCloudSeed;
@@ -360,13 +445,17 @@ void GenerateOptions::validate() {
                         std::to_string(kMaxGeneratedVoxels) + "]");
         return;
     }
-    if (!res) res = kind == "checkerbox" ? kDefaultCheckerRes : kind == "sphere" ? kDefaultSphereRes : kDefaultMarschnerLobbRes;
+    if (!res)
+        res = kind == "checkerbox" ? kDefaultCheckerRes
+              : kind == "sphere"   ? kDefaultSphereRes
+              : tubes              ? kDefaultTubesRes
+                                   : kDefaultMarschnerLobbRes;
     const int minRes = kind == "sphere" ? 3 : 2;
     if (*res < minRes || *res > kMaxGenerateRes)
         throw Error("--res: " + std::to_string(*res) + " is outside [" + std::to_string(minRes) + ", " +
                     std::to_string(kMaxGenerateRes) + "]");
     const double cubeVoxels = std::pow(double(*res), 3.0);
-    const double voxels = kind == "sphere" ? cubeVoxels * std::numbers::pi / 6.0 : cubeVoxels;
+    const double voxels = kind == "sphere" ? cubeVoxels * std::numbers::pi / 6.0 : tubes ? 0.0 : cubeVoxels;
     if (voxels > double(kMaxGeneratedVoxels))
         throw Error("--res: " + std::to_string(*res) + " would make about " + std::to_string(uint64_t(voxels)) +
                     " active voxels, more than the limit of " + std::to_string(kMaxGeneratedVoxels));
@@ -377,6 +466,8 @@ openvdb::FloatGrid::Ptr generateVolume(GenerateOptions options) {
     if (options.kind == "checkerbox") return makeCheckerBox(*options.res);
     if (options.kind == "marschner-lobb") return makeMarschnerLobb(*options.res);
     if (options.kind == "sphere") return makeSphere(*options.res);
+    if (options.kind == "tubes")
+        return makeTubes(*options.res, *options.count, *options.sheets, *options.radiusMin, *options.radiusMax, *options.seed);
     return makeCloud(*options.active, *options.seed);
 }
 
@@ -439,6 +530,86 @@ openvdb::FloatGrid::Ptr makeCloud(uint64_t active, uint64_t seed) {
         cutCandidates(grid->tree(), threshold, std::max(top - threshold, 1e-6));
         return grid;
     }
+}
+
+void GenerateOptions::validateTubes() {
+    if (!seed) seed = kDefaultCloudSeed;
+    if (!count) count = kDefaultTubeCount;
+    if (!sheets) sheets = kDefaultSheetCount;
+    if (!radiusMin) radiusMin = kDefaultTubeRadiusMin;
+    if (!radiusMax) radiusMax = std::max(kDefaultTubeRadiusMax, *radiusMin);
+    if (*count < 0 || *count > kMaxTubeCount)
+        throw Error("--count: " + std::to_string(*count) + " is outside [0, " + std::to_string(kMaxTubeCount) + "]");
+    if (*sheets < 0 || *sheets > kMaxTubeCount)
+        throw Error("--sheets: " + std::to_string(*sheets) + " is outside [0, " + std::to_string(kMaxTubeCount) + "]");
+    const auto inRange = [](double r) { return r >= kMinTubeRadius && r <= kMaxTubeRadius; };
+    if (!inRange(*radiusMin) || !inRange(*radiusMax))
+        throw Error("--radius-min/--radius-max: radii must lie in [" + std::to_string(kMinTubeRadius) + ", " +
+                    std::to_string(kMaxTubeRadius) + "] voxels");
+    if (*radiusMin > *radiusMax) throw Error("--radius-min: larger than --radius-max");
+}
+
+double tubeProfile(double d, double r) {
+    if (d <= r) return 1.0;
+    const double s = (d - r) / kTubeFalloffVoxels;
+    return s < 1.0 ? (1.0 - s * s) * (1.0 - s * s) : 0.0;
+}
+
+double tubeDistance(const TubePrimitive& t, const openvdb::Vec3d& x) {
+    if (t.sheet) {  // disc of radius `extent` in the plane through a with normal n
+        const openvdb::Vec3d q = x - t.a;
+        const double h = q.dot(t.n);
+        const double rho = (q - h * t.n).length();
+        const double out = std::max(rho - t.extent, 0.0);
+        return std::sqrt(h * h + out * out);
+    }
+    double best = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < kTubeSegments; ++k)
+        best = std::min(best, segmentDistance(bezier(t, double(k) / kTubeSegments), bezier(t, double(k + 1) / kTubeSegments), x));
+    return best;
+}
+
+std::vector<TubePrimitive> tubeLayout(int res, int count, int sheets, double radiusMin, double radiusMax, uint64_t seed) {
+    const double lo = kTubeMarginFraction * (res - 1), hi = (res - 1) - lo;
+    std::vector<TubePrimitive> layout;
+    uint64_t draw = 0;  // index of the next random number
+    const auto u = [&](uint64_t stream) { return uniform01(seed, stream, draw++); };
+    const auto inBox = [&](uint64_t stream) {
+        const double x = u(stream), y = u(stream), z = u(stream);
+        return openvdb::Vec3d(lo + x * (hi - lo), lo + y * (hi - lo), lo + z * (hi - lo));
+    };
+    for (int i = 0; i < count; ++i) {
+        TubePrimitive t;
+        t.a = inBox(1), t.b = inBox(1);
+        for (int tries = 0; tries < 64 && (t.b - t.a).length() < kTubeMinLengthFraction * res; ++tries) t.b = inBox(1);
+        const openvdb::Vec3d bend(u(2) - 0.5, u(2) - 0.5, u(2) - 0.5);
+        t.m = 0.5 * (t.a + t.b) + 2.0 * kTubeBendFraction * res * bend;
+        t.m = openvdb::Vec3d(std::clamp(t.m.x(), lo, hi), std::clamp(t.m.y(), lo, hi), std::clamp(t.m.z(), lo, hi));
+        t.r = radiusMin + u(3) * (radiusMax - radiusMin);
+        layout.push_back(t);
+    }
+    for (int i = 0; i < sheets; ++i) {
+        TubePrimitive s;
+        s.sheet = true;
+        const double mid = 0.5 * (res - 1), spread = 0.2 * (res - 1);
+        s.a = openvdb::Vec3d(mid + spread * (2.0 * u(4) - 1.0), mid + spread * (2.0 * u(4) - 1.0), mid + spread * (2.0 * u(4) - 1.0));
+        // A uniform direction: z uniform in [−1, 1], azimuth uniform (Archimedes).
+        const double z = 2.0 * u(5) - 1.0, phi = 2.0 * std::numbers::pi * u(5), rxy = std::sqrt(std::max(0.0, 1.0 - z * z));
+        s.n = openvdb::Vec3d(rxy * std::cos(phi), rxy * std::sin(phi), z);
+        s.extent = (kSheetExtentMin + u(6) * (kSheetExtentMax - kSheetExtentMin)) * res;
+        s.r = radiusMin + u(3) * (radiusMax - radiusMin);
+        layout.push_back(s);
+    }
+    return layout;
+}
+
+openvdb::FloatGrid::Ptr makeTubes(int res, int count, int sheets, double radiusMin, double radiusMax, uint64_t seed) {
+    const std::vector<TubePrimitive> layout = tubeLayout(res, count, sheets, radiusMin, radiusMax, seed);
+    const std::vector<TubePiece> pieces = tubePieces(layout);
+    char label[160];
+    std::snprintf(label, sizeof label, "tubes res=%d count=%d sheets=%d radius=%g..%g seed=%llu", res, count, sheets,
+                  radiusMin, radiusMax, (unsigned long long)seed);
+    return buildGridFromLeaves(cube(res), label, [&](const Coord& origin) { return buildTubeLeaf(pieces, origin, cube(res)); });
 }
 
 }  // namespace vdbsplat

@@ -4,7 +4,9 @@
 //  - checkerbox:     the 3D Checker Box of Yuan et al. 2003 (every voxel active),
 //  - marschner-lobb: the Marschner–Lobb 1994 test signal (f_M = 6, α = 0.25),
 //  - sphere:         a smooth fog ball,
-//  - cloud:          thresholded fractal value noise with a requested active count.
+//  - cloud:          thresholded fractal value noise with a requested active count,
+//  - tubes:          random thin tubes and a few thin sheets (DESIGN §8.3: structures one or
+//                    two pixels wide, where filtering optical depth before compositing fails).
 // Every grid is built leaf by leaf (8³) in parallel and inserted in a fixed order,
 // so the result is identical for any thread count and never densified.
 #pragma once
@@ -34,17 +36,31 @@ inline constexpr double kCloudCountTolerance = 0.02;
 /// Default sizes.
 inline constexpr int kDefaultCheckerRes = 100, kDefaultMarschnerLobbRes = 41, kDefaultSphereRes = 64;
 inline constexpr uint64_t kDefaultCloudActive = 1'000'000, kDefaultCloudSeed = 1;
+/// Tubes: the defaults make issue 10's reference volume (14 tubes, radius 0.7–2.5 voxels).
+inline constexpr int kDefaultTubesRes = 128, kDefaultTubeCount = 14, kDefaultSheetCount = 2;
+inline constexpr double kDefaultTubeRadiusMin = 0.7, kDefaultTubeRadiusMax = 2.5;
+/// Tubes: density 1 within the radius, then (1 − (s/w)²)² over a rim of w voxels (C¹), 0 beyond.
+inline constexpr double kTubeFalloffVoxels = 1.0;
+/// Tubes: radius bounds accepted by --radius-min/--radius-max (voxels), and the most tubes/sheets.
+inline constexpr double kMinTubeRadius = 0.1, kMaxTubeRadius = 64.0;
+inline constexpr int kMaxTubeCount = 100000;
 
 /// @brief What to generate; unset fields take the kind's default in validate().
 struct GenerateOptions {
     std::string kind{};             ///< checkerbox | marschner-lobb | sphere | cloud
     std::optional<int> res{};       ///< grid side in voxels (not for cloud)
     std::optional<uint64_t> active{}; ///< cloud only: target active voxel count
-    std::optional<uint64_t> seed{};   ///< cloud only: noise seed
+    std::optional<uint64_t> seed{};   ///< cloud and tubes: seed
+    std::optional<int> count{};       ///< tubes only: number of tubes
+    std::optional<int> sheets{};      ///< tubes only: number of thin sheets
+    std::optional<double> radiusMin{}, radiusMax{};  ///< tubes only: radius range (voxels)
 
     /// @brief Fills in defaults and checks the combination (messages name the flag).
     /// @throw Error for an unknown kind, a flag the kind does not use, or sizes out of bounds.
     void validate();
+
+private:
+    void validateTubes();  ///< validate()'s part for 'tubes'
 };
 
 /// @brief The names accepted as GenerateOptions::kind, in documentation order.
@@ -78,5 +94,31 @@ openvdb::FloatGrid::Ptr makeSphere(int res);
 /// memory proportional to the active voxels (the domain is visited leaf by leaf, never stored).
 /// @param active target active count (validated by GenerateOptions)
 openvdb::FloatGrid::Ptr makeCloud(uint64_t active, uint64_t seed);
+
+/// @brief One tube of makeTubes: a quadratic Bézier axis a → b with control point m, radius r.
+/// One sheet: a disc of radius `extent` around a with unit normal n, half-thickness r.
+struct TubePrimitive {
+    bool sheet = false;
+    openvdb::Vec3d a, m, b;  ///< tube: Bézier points; sheet: a is the centre
+    openvdb::Vec3d n;        ///< sheet: unit normal
+    double extent = 0.0;     ///< sheet: disc radius (voxels)
+    double r = 0.0;          ///< tube radius / sheet half-thickness (voxels)
+};
+
+/// @brief The tubes and sheets makeTubes draws for these options (deterministic by seed).
+std::vector<TubePrimitive> tubeLayout(int res, int count, int sheets, double radiusMin, double radiusMax, uint64_t seed);
+
+/// @brief Distance (voxels) from @p x to the axis of a tube (the polyline of its Bézier, 32
+/// segments) or to the mid-surface of a sheet (the disc).
+double tubeDistance(const TubePrimitive& t, const openvdb::Vec3d& x);
+
+/// @brief Density at distance @p d from a primitive of radius @p r: 1 for d ≤ r, then
+/// (1 − ((d − r)/w)²)² for d < r + w (w = kTubeFalloffVoxels), else 0.
+double tubeProfile(double d, double r);
+
+/// @brief Random thin tubes (quadratic Bézier axes crossing the res³ box) and thin discs:
+/// density max over primitives of tubeProfile(tubeDistance), active where > 0.
+/// Deterministic by @p seed for any thread count. Options validated by GenerateOptions.
+openvdb::FloatGrid::Ptr makeTubes(int res, int count, int sheets, double radiusMin, double radiusMax, uint64_t seed);
 
 }  // namespace vdbsplat

@@ -16,6 +16,10 @@ namespace {
 using openvdb::Coord;
 using openvdb::CoordBBox;
 
+/// Active voxels of `vdbsplat generate tubes` with the defaults (res 128, 14 tubes, 2 sheets,
+/// radius 0.7–2.5, seed 1); also in volumes/make-generated.sh.
+constexpr uint64_t kPinnedTubesActive = 34740;
+
 /// True when @p a and @p b have the same active voxels with bit-identical values.
 bool sameGrid(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b) {
     if (a.activeVoxelCount() != b.activeVoxelCount()) return false;
@@ -131,6 +135,80 @@ TEST(Generate, CloudIsDeterministicBySeedAndThreadCount) {
     EXPECT_TRUE(sameGrid(*a, *serial));
 }
 
+/// Issue 10's reference volume (the defaults): its active count is pinned, so a change to the
+/// layout or the profile shows; the same seed gives the same grid, another seed another one.
+TEST(Generate, TubesAreDeterministicBySeedAndThreadCount) {
+    GenerateOptions opt{"tubes"};
+    opt.validate();
+    EXPECT_EQ(*opt.res, kDefaultTubesRes);
+    EXPECT_EQ(*opt.count, kDefaultTubeCount);
+    auto a = generateVolume(opt);
+    EXPECT_EQ(a->activeVoxelCount(), kPinnedTubesActive);
+    auto b = generateVolume(opt);
+    EXPECT_TRUE(sameGrid(*a, *b));
+    openvdb::FloatGrid::Ptr serial;
+    {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        serial = generateVolume(opt);
+    }
+    EXPECT_TRUE(sameGrid(*a, *serial));
+    GenerateOptions other = opt;
+    other.seed = 2;
+    EXPECT_FALSE(sameGrid(*a, *generateVolume(other)));
+}
+
+/// Geometry: voxels on a tube's axis are active with density 1, voxels past radius + falloff
+/// from every tube and sheet are inactive, and every active value is the profile of the
+/// distance to the nearest primitive.
+TEST(Generate, TubesFollowTheirLayout) {
+    const int res = 64, count = 5, sheets = 1;
+    const double rmin = 0.7, rmax = 2.5;
+    const uint64_t seed = 3;
+    const auto layout = tubeLayout(res, count, sheets, rmin, rmax, seed);
+    ASSERT_EQ(layout.size(), size_t(count + sheets));
+    auto grid = makeTubes(res, count, sheets, rmin, rmax, seed);
+    auto acc = grid->getConstAccessor();
+    int onAxis = 0;
+    for (const TubePrimitive& t : layout) {
+        if (t.sheet) continue;
+        EXPECT_GE(t.r, rmin);
+        EXPECT_LE(t.r, rmax);
+        EXPECT_GE((t.b - t.a).length(), 0.5 * res);
+        for (double u : {0.25, 0.5, 0.75}) {  // the voxel nearest a point of the axis
+            const openvdb::Vec3d p = (1 - u) * (1 - u) * t.a + 2 * u * (1 - u) * t.m + u * u * t.b;
+            const Coord c(int(std::lround(p.x())), int(std::lround(p.y())), int(std::lround(p.z())));
+            EXPECT_TRUE(acc.isValueOn(c)) << c;
+            EXPECT_GT(acc.getValue(c), 0.25f) << c;  // ≤ √3/2 voxel from the axis
+            if (tubeDistance(t, openvdb::Vec3d(c.x(), c.y(), c.z())) <= t.r) {
+                EXPECT_EQ(acc.getValue(c), 1.0f) << c;
+                ++onAxis;
+            }
+        }
+    }
+    EXPECT_GT(onAxis, 0);
+    uint64_t far = 0, checked = 0;
+    for (int z = 0; z < res; z += 3)
+        for (int y = 0; y < res; y += 3)
+            for (int x = 0; x < res; x += 3) {
+                const openvdb::Vec3d p(x, y, z);
+                double v = 0.0;
+                for (const TubePrimitive& t : layout) v = std::max(v, tubeProfile(tubeDistance(t, p), t.r));
+                const Coord c(x, y, z);
+                EXPECT_EQ(acc.isValueOn(c), v > 0.0) << c;
+                EXPECT_NEAR(acc.getValue(c), v, 1e-6) << c;
+                far += v == 0.0, ++checked;
+            }
+    EXPECT_GT(far, checked / 2);  // thin: most of the box is empty
+}
+
+TEST(Generate, TubeProfileIsSmooth) {
+    EXPECT_EQ(tubeProfile(0.0, 1.0), 1.0);
+    EXPECT_EQ(tubeProfile(1.0, 1.0), 1.0);
+    EXPECT_NEAR(tubeProfile(1.5, 1.0), 0.5625, 1e-12);  // (1 − 0.25)²
+    EXPECT_EQ(tubeProfile(2.0, 1.0), 0.0);
+    EXPECT_EQ(tubeProfile(7.0, 1.0), 0.0);
+}
+
 TEST(Generate, GridsLoadAsVolumes) {
     for (const auto& kind : generatorKinds()) {
         GenerateOptions opt{kind};
@@ -157,6 +235,14 @@ TEST(Generate, RejectsBadOptions) {
     fails({"cloud", 64}, "--res");
     fails({"sphere", std::nullopt, 100}, "--active");
     fails({"checkerbox", std::nullopt, std::nullopt, 3}, "--seed");
+    fails({"sphere", std::nullopt, std::nullopt, std::nullopt, 4}, "--count");
+    fails({"cloud", std::nullopt, std::nullopt, std::nullopt, std::nullopt, 1}, "--sheets");
+    fails({"checkerbox", std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt, 1.0}, "--radius");
+    fails({"tubes", std::nullopt, std::nullopt, std::nullopt, -1}, "--count");
+    fails({"tubes", std::nullopt, std::nullopt, std::nullopt, std::nullopt, -2}, "--sheets");
+    fails({"tubes", std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt, 3.0, 2.0}, "--radius-min");
+    fails({"tubes", std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt, 0.01}, "--radius");
+    fails({"tubes", std::nullopt, 100}, "--active");
     fails({"checkerbox", 4096}, "--res");  // 6.9e10 voxels
     fails({"checkerbox", 5000}, "--res");
     fails({"sphere", 2}, "--res");

@@ -140,7 +140,7 @@ TEST(VolumesCatalogue, ListsEveryVolumeWithItsActiveVoxels) {
     EXPECT_EQ(active.count("engine") ? active.at("engine") : -1, 1328027);
     EXPECT_EQ(active.count("checkerbox") ? active.at("checkerbox") : -1, 1000000);
     EXPECT_EQ(active.count("marschner-lobb") ? active.at("marschner-lobb") : -1, 41 * 41 * 41);
-    for (const char* name : {"bonsai", "smoke", "sphere", "cloud"}) EXPECT_TRUE(active.count(name)) << name;
+    for (const char* name : {"bonsai", "smoke", "sphere", "cloud", "tubes"}) EXPECT_TRUE(active.count(name)) << name;
     const auto sha = catalogueColumn("sha256");
     for (const char* name : {"engine", "bonsai", "smoke"}) {
         ASSERT_TRUE(sha.count(name)) << name;
@@ -259,16 +259,16 @@ TEST(VolumesMakeGenerated, WritesTheCataloguedVolumes) {
     const CliResult r = runScript("make-generated.sh", "--out " + quote(out), scratch.dir());
     ASSERT_EQ(r.rc, 0) << r.out << r.err;
     const auto active = catalogueActive();
-    for (const char* name : {"checkerbox", "marschner-lobb", "sphere", "cloud"}) {
+    for (const char* name : {"checkerbox", "marschner-lobb", "sphere", "cloud", "tubes"}) {
         const std::string vdb = out + "/" + name + ".vdb";
         ASSERT_TRUE(fs::exists(vdb)) << vdb;
         ASSERT_TRUE(active.count(name)) << name << " is not in the catalogue";
         EXPECT_EQ(activeVoxels(vdb, scratch.dir()), active.at(name)) << vdb;
     }
-    const CliResult bad = runScript("make-generated.sh", "--out " + quote(out) + " tubes", scratch.dir());
+    const CliResult bad = runScript("make-generated.sh", "--out " + quote(out) + " explosion", scratch.dir());
     EXPECT_EQ(bad.rc, 1);
     EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
-    EXPECT_NE(bad.err.find("unknown volume 'tubes'"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("unknown volume 'explosion'"), std::string::npos) << bad.err;
 }
 
 }  // namespace
