@@ -3,10 +3,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 
 #include "footprint/tables.h"
 #include "render/hybrid.h"
 #include "render/reference.h"
+#include "shading/shading_field.h"
 #include "util/error.h"
 
 namespace vdbsplat {
@@ -60,15 +62,23 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     const ClassificationTable table = tf.bake(lo, hi, volume.voxelSize);
     const Camera camera = cameraFor(volume, settings);
     stats.activeVoxels = volume.activeVoxels;
+    // Pre-shading (docs/shading.md): one pass over the voxels, the same field for every mode.
+    std::unique_ptr<ShadingField> shading;
+    if (settings.shading.active()) {
+        shading = std::make_unique<ShadingField>(volume, table, lo, hi, camera.eye(), settings.shading);
+        stats.shadingSeconds = shading->seconds();
+    }
     Image image;
     switch (settings.mode) {
-        case RenderMode::Reference: image = renderReference(volume, table, camera, settings.spp, stats); break;
+        case RenderMode::Reference:
+            image = renderReference(volume, table, camera, settings.spp, stats, shading.get());
+            break;
         case RenderMode::Hybrid:
         case RenderMode::Splat:
         case RenderMode::Point: {
             const Tables tables =
                 loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir));
-            image = renderForward(volume, table, camera, tables, settings, stats);
+            image = renderForward(volume, table, camera, tables, settings, stats, shading.get());
             break;
         }
     }

@@ -40,6 +40,7 @@ void RenderSettings::validate() const {
         throw Error("--lod: must be a number of pixels in [0, 64] (0 turns level of detail off)");
     if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
         throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
+    shading.validate();
     if (!tablesDir.empty()) {
         std::error_code ec;
         if (!std::filesystem::is_directory(tablesDir, ec))
@@ -90,6 +91,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["lod"] = lodPx;
     j["simd"] = simd;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
+    if (shading.active()) j["shading"] = shading.toJson();  // absent when off: unshaded outputs unchanged
     return j;
 }
 
@@ -114,6 +116,7 @@ nlohmann::json RenderStats::toJson() const {
     if (raysPerPixel) j["rays_per_pixel"] = raysPerPixel;
     j["stage_seconds"] = {{"stream", streamSeconds}, {"project", projectSeconds},
                           {"rasterize", rasterizeSeconds}, {"composite", compositeSeconds}};
+    if (shadingSeconds > 0.0) j["stage_seconds"]["shading"] = shadingSeconds;
     return j;
 }
 
