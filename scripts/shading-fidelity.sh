@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The shading rows of docs/shading.md: PSNR of hybrid against the reference, unshaded and with
 # --shading ct (the reference equally shaded), for the checker box (grey) and the Engine
-# (ct-bone) at the three standard views (--distance 8, 1, 0.35), plus the shading pass's time
-# against the whole hybrid render. Same method as scripts/fidelity.sh; smaller images by default.
+# (ct-bone) at the three standard views (--distance 8, 1, 0.35). Same method as
+# scripts/fidelity.sh; smaller images by default. (The cost of shading: vdbsplat bench
+# --shading ct against --shading off, docs/shading.md.)
 # Reference images are cached in out/shading/ (delete them to re-render).
 # Usage: scripts/shading-fidelity.sh [--size WxH] [--spp N]      (default 256x256, 16 rays)
 # Writes out/shading/shading.tsv and prints one line per row.
@@ -31,7 +32,7 @@ fi
 
 json() { sed -E "s/.*\"$2\": *([^,}]+).*/\1/" <<<"$(tr -d '\n' < "$1")"; }
 
-printf "volume\tdistance\tshading\tpsnr_db\tssim\trender_s\tshading_s\n" > $OUT/shading.tsv
+printf "volume\tdistance\tshading\tpsnr_db\tssim\trender_s\n" > $OUT/shading.tsv
 for entry in $VOLUMES; do
   vol=${entry%%:*} tf=${entry##*:}
   for d in 8 1 0.35; do
@@ -47,10 +48,8 @@ for entry in $VOLUMES; do
       psnr=$(sed -E 's/.*psnr=([^ ]+) dB.*/\1/' <<<"$m")
       ssim=$(sed -E 's/.*ssim=([^ ]+) .*/\1/' <<<"$m")
       secs=$(json $OUT/stats.json seconds)
-      shade=0
-      [[ $shading == off ]] || shade=$(json $OUT/stats.json shading)
-      printf "%s\t%s\t%s\t%.2f\t%.4f\t%.3f\t%.4f\n" $vol $d $shading $psnr $ssim $secs $shade >> $OUT/shading.tsv
-      echo "$vol distance $d shading $shading: $m (render $secs s, shading pass $shade s)"
+      printf "%s\t%s\t%s\t%.2f\t%.4f\t%.3f\n" $vol $d $shading $psnr $ssim $secs >> $OUT/shading.tsv
+      echo "$vol distance $d shading $shading: $m (hybrid $secs s)"
     done
   done
 done

@@ -18,13 +18,13 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     const Tables& tables, const RenderSettings& settings, RenderStats& stats,
-                    const ShadingField* shading) {
+                    const VoxelShader* shader) {
     StreamOptions streamOptions = settings.stream;
     streamOptions.lodCellPx = settings.lodPx;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point   ? INFINITY
                                  : settings.mode == RenderMode::Splat ? 0.0
                                                                       : settings.threshold;
-    VoxelStream stream(volume, camera, table, streamOptions, shading);
+    VoxelStream stream(volume, camera, table, streamOptions, shader);
     TileCompositor compositor(camera.width(), camera.height(), tables, ExactContext{&camera, volume.voxelSize, settings.simd});
     const ProjectionContext ctx{camera,          tables,           volume.voxelSize,  stream.slabLength(),
                                 settings.mode,   settings.threshold, settings.footprint, settings.showPrimitives};

@@ -16,6 +16,6 @@ namespace vdbsplat {
 /// @brief Renders @p volume in settings.mode (Hybrid, Splat or Point).
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     const Tables& tables, const RenderSettings& settings, RenderStats& stats,
-                    const ShadingField* shading = nullptr);
+                    const VoxelShader* shader = nullptr);
 
 }  // namespace vdbsplat

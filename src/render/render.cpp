@@ -62,23 +62,29 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     const ClassificationTable table = tf.bake(lo, hi, volume.voxelSize);
     const Camera camera = cameraFor(volume, settings);
     stats.activeVoxels = volume.activeVoxels;
-    // Pre-shading (docs/shading.md): one pass over the voxels, the same field for every mode.
-    std::unique_ptr<ShadingField> shading;
-    if (settings.shading.active()) {
-        shading = std::make_unique<ShadingField>(volume, table, lo, hi, camera.eye(), settings.shading);
-        stats.shadingSeconds = shading->seconds();
-    }
+    // Shading (docs/shading.md): one VoxelShader for every mode. The reference reads each voxel
+    // many times and takes the whole field, computed once; the forward modes shade the voxels
+    // they draw as the stream classifies them.
+    std::unique_ptr<VoxelShader> shader;
+    if (settings.shading.active())
+        shader = std::make_unique<VoxelShader>(volume, table, lo, hi, camera.eye(), settings.shading);
     Image image;
     switch (settings.mode) {
-        case RenderMode::Reference:
-            image = renderReference(volume, table, camera, settings.spp, stats, shading.get());
+        case RenderMode::Reference: {
+            std::unique_ptr<ShadingField> field;
+            if (shader) {
+                field = std::make_unique<ShadingField>(*shader);
+                stats.shadingSeconds = field->seconds();
+            }
+            image = renderReference(volume, table, camera, settings.spp, stats, field.get());
             break;
+        }
         case RenderMode::Hybrid:
         case RenderMode::Splat:
         case RenderMode::Point: {
             const Tables tables =
                 loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir));
-            image = renderForward(volume, table, camera, tables, settings, stats, shading.get());
+            image = renderForward(volume, table, camera, tables, settings, stats, shader.get());
             break;
         }
     }

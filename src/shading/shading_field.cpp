@@ -23,23 +23,14 @@ glm::vec3 gradientOf(const float raw[6], float lo, float hi) {
     return centralDifference(n);
 }
 
-/// Everything one voxel's shading needs that does not change from voxel to voxel.
-struct PassContext {
-    const ClassificationTable& table;
-    const ShadingSettings& settings;
-    glm::dmat4 indexToWorld;
-    glm::mat3 gradientToWorld;  ///< transpose of worldToIndex's linear part: ∇_world = Aᵀ ∇_index
-    glm::dvec3 eye;
-    float background, lo, hi;
-};
-
 using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 
 /// The six neighbours' raw values of voxel @p n (leaf offset) at @p ijk: read from @p leaf
 /// directly where the neighbour is inside it (an inactive one reads as the background), through
 /// @p acc otherwise — the same values gradientAt() reads, at a fraction of the cost.
-void neighbourValues(const FloatLeaf* leaf, openvdb::Index n, const openvdb::Coord& ijk,
-                     openvdb::FloatGrid::ConstAccessor& acc, float background, float out[6]) {
+template <typename AccessorT>
+void neighbourValues(const FloatLeaf* leaf, openvdb::Index n, const openvdb::Coord& ijk, AccessorT& acc,
+                     float background, float out[6]) {
     static constexpr openvdb::Index kStride[3] = {FloatLeaf::DIM * FloatLeaf::DIM, FloatLeaf::DIM, 1};
     const openvdb::Coord local = ijk - (leaf ? leaf->origin() : ijk);
     for (int axis = 0; axis < 3; ++axis)
@@ -57,22 +48,6 @@ void neighbourValues(const FloatLeaf* leaf, openvdb::Index n, const openvdb::Coo
         }
 }
 
-openvdb::Vec3f shadeAt(openvdb::FloatGrid::ConstAccessor& acc, const FloatLeaf* leaf, openvdb::Index n,
-                       const openvdb::Coord& ijk, float value, const PassContext& c) {
-    if (!(c.table.sigma(value) > 0.f)) return {1.f, 0.f, 1.f};  // drawn by nobody: leave it unshaded
-    float raw[6];
-    neighbourValues(leaf, n, ijk, acc, c.background, raw);
-    const glm::vec3 g = gradientOf(raw, c.lo, c.hi);
-    const float magnitude = glm::length(g);
-    const glm::dvec3 x(c.indexToWorld * glm::dvec4(ijk.x(), ijk.y(), ijk.z(), 1.0));
-    const glm::dvec3 toEyeD = c.eye - x;
-    const double eyeDistance = glm::length(toEyeD);
-    const glm::vec3 toEye = eyeDistance > 0.0 ? glm::vec3(toEyeD / eyeDistance) : glm::vec3(0.f);
-    const glm::vec3 toLight = c.settings.hasLight ? glm::vec3(glm::normalize(c.settings.light)) : toEye;
-    const ShadingFactors f = shadeVoxel(c.gradientToWorld * g, magnitude, toEye, toLight, c.settings);
-    return {f.diffuse, f.specular, gradientOpacityFactor(magnitude, c.settings.gradientOpacity)};
-}
-
 }  // namespace
 
 glm::vec3 gradientAt(openvdb::FloatGrid::ConstAccessor& acc, const openvdb::Coord& ijk, float background, float lo,
@@ -82,33 +57,48 @@ glm::vec3 gradientAt(openvdb::FloatGrid::ConstAccessor& acc, const openvdb::Coor
     return gradientOf(raw, lo, hi);
 }
 
-ShadingField::ShadingField(const Volume& volume, const ClassificationTable& table, float lo, float hi,
-                           const glm::dvec3& eye, const ShadingSettings& settings) {
+VoxelShader::VoxelShader(const Volume& volume, const ClassificationTable& table, float lo, float hi,
+                         const glm::dvec3& eye, const ShadingSettings& settings)
+    : volume_(volume), table_(table), settings_(settings),
+      gradientToWorld_(glm::transpose(glm::mat3(glm::dmat3(volume.worldToIndex)))), eye_(eye),
+      background_(volume.grid->background()), lo_(lo), hi_(hi > lo ? hi : lo + 1.f) {
+    if (settings.hasLight) toLight_ = glm::vec3(glm::normalize(settings.light));
+}
+
+openvdb::Vec3f VoxelShader::operator()(Accessor& acc, const FloatLeaf* leaf, openvdb::Index n,
+                                       const openvdb::Coord& ijk, float value) const {
+    if (!(table_.sigma(value) > 0.f)) return {1.f, 0.f, 1.f};  // drawn by nobody: leave it unshaded
+    float raw[6];
+    neighbourValues(leaf, n, ijk, acc, background_, raw);
+    const glm::vec3 g = gradientOf(raw, lo_, hi_);
+    const float magnitude = glm::length(g);
+    const glm::dvec3 x(volume_.indexToWorld * glm::dvec4(ijk.x(), ijk.y(), ijk.z(), 1.0));
+    const glm::dvec3 toEyeD = eye_ - x;
+    const double eyeDistance = glm::length(toEyeD);
+    const glm::vec3 toEye = eyeDistance > 0.0 ? glm::vec3(toEyeD / eyeDistance) : glm::vec3(0.f);
+    const glm::vec3 toLight = settings_.hasLight ? toLight_ : toEye;
+    const ShadingFactors f = shadeVoxel(gradientToWorld_ * g, magnitude, toEye, toLight, settings_);
+    return {f.diffuse, f.specular, gradientOpacityFactor(magnitude, settings_.gradientOpacity)};
+}
+
+ShadingField::ShadingField(const VoxelShader& shader) {
     const auto start = std::chrono::steady_clock::now();
+    const openvdb::FloatGrid& grid = *shader.volume().grid;
     const openvdb::Vec3f unshaded(1.f, 0.f, 1.f);
-    tree_ = std::make_shared<Tree>(volume.grid->tree(), unshaded, unshaded, openvdb::TopologyCopy());
+    tree_ = std::make_shared<Tree>(grid.tree(), unshaded, unshaded, openvdb::TopologyCopy());
     tree_->voxelizeActiveTiles();
     std::vector<Leaf*> leaves;
     leaves.reserve(tree_->leafCount());
     tree_->getNodes(leaves);
-    const PassContext context{table,
-                              settings,
-                              volume.indexToWorld,
-                              glm::transpose(glm::mat3(glm::dmat3(volume.worldToIndex))),
-                              eye,
-                              volume.grid->background(),
-                              lo,
-                              hi > lo ? hi : lo + 1.f};
-    const openvdb::FloatGrid& grid = *volume.grid;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
-        openvdb::FloatGrid::ConstAccessor acc = grid.getConstAccessor();  // one per task, never shared
+        VoxelShader::Accessor acc(grid.tree());  // one per task, never shared
         for (size_t i = r.begin(); i < r.end(); ++i) {
             Leaf& leaf = *leaves[i];
             const FloatLeaf* source = grid.tree().probeConstLeaf(leaf.origin());  // null: a voxelized tile
             for (auto it = leaf.beginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
                 const float value = source ? source->getValue(it.pos()) : acc.getValue(ijk);
-                it.setValue(shadeAt(acc, source, it.pos(), ijk, value, context));
+                it.setValue(shader(acc, source, it.pos(), ijk, value));
             }
         }
     });

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "footprint/kernel.h"
 #include "shading/shading_field.h"
@@ -43,8 +44,8 @@ void VoxelBatch::clear() {
 }
 
 VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
-                         const StreamOptions& options, const ShadingField* shading)
-    : volume_(volume), camera_(camera), table_(table), options_(options), shading_(shading),
+                         const StreamOptions& options, const VoxelShader* shader)
+    : volume_(volume), camera_(camera), table_(table), options_(options), shader_(shader),
       slabLength_(options.slabThickness * volume.voxelSize), slabsPerWindow_(std::max(1, options.slabsPerWindow)) {
     if (volume.activeVoxels > kMaxActiveVoxels)
         throw Error(volume.file + ": grid '" + volume.name + "' has " + std::to_string(volume.activeVoxels) +
@@ -164,13 +165,17 @@ int VoxelStream::lodLevel(const Block& b) const {
 }
 
 /// Calls fn(local index (0..dim−1 per axis), classification) for every active voxel of the
-/// block: the table's, then the shading pass's factors when shading is on.
+/// block: the table's, then shaded (VoxelShader, the same factors the reference reads) when
+/// shading is on. Shading here, in the parallel extraction, costs only the voxels drawn.
 template <typename Fn>
 void VoxelStream::forEachActive(const Block& b, Fn&& fn) const {
-    const ShadingField::Leaf* shaded = shading_ ? shading_->leaf(b.origin) : nullptr;
+    std::optional<VoxelShader::Accessor> acc;
+    if (shader_) acc.emplace(volume_.grid->tree());  // per block: blocks run on any thread
     const auto classify = [&](openvdb::Index n, float value) {
         const Classified cls = table_(value);
-        return shaded ? applyShading(cls, shaded->getValue(n)) : cls;
+        if (!shader_ || !(cls.sigma > 0.f)) return cls;
+        const openvdb::Coord ijk = b.origin.offsetBy(int(n >> 6), int((n >> 3) & 7), int(n & 7));
+        return applyShading(cls, (*shader_)(*acc, b.leaf, n, ijk, value));
     };
     if (b.leaf) {
         const float* values = b.leaf->buffer().data();

@@ -221,11 +221,11 @@ TEST(ShadingField, DoesNotDependOnTheThreadCount) {
     std::unique_ptr<ShadingField> one, two;
     {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-        one = std::make_unique<ShadingField>(v, table, 0.f, 1.f, eye, s);
+        one = std::make_unique<ShadingField>(VoxelShader(v, table, 0.f, 1.f, eye, s));
     }
     {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-        two = std::make_unique<ShadingField>(v, table, 0.f, 1.f, eye, s);
+        two = std::make_unique<ShadingField>(VoxelShader(v, table, 0.f, 1.f, eye, s));
     }
     uint64_t shaded = 0;
     ShadingField::Accessor acc(two->tree());
