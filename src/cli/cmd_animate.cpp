@@ -377,7 +377,7 @@ int runAnimate(const Argv& argv) {
     valueFlags.insert({"-o", "--from", "--to", "--frames", "--orbit", "--path", "--fps", "--format"});
     const Args args(argv, valueFlags, {"--show-primitives", "--resume", "--force", "--reference", "--mp4"});
     if (args.wantsHelp()) {
-        std::cout << kHelp;
+        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp;
         return 0;
     }
     Options o = optionsFrom(args);

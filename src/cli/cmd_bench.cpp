@@ -17,6 +17,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -157,6 +158,7 @@ Options optionsFrom(const Args& args) {
         const auto u = parseDoubleList(*v, "--up", 3);
         s.camera.up = {u[0], u[1], u[2]};
     }
+    s.shading = shadingFromFlags(args);
     if (auto v = args.get("--runs")) o.runs = int(parseInt(*v, "--runs", 1, kMaxRuns));
     if (auto v = args.get("--warmup")) o.warmup = int(parseInt(*v, "--warmup", 0, kMaxWarmup));
     if (auto v = args.get("--modes")) o.modes = parseModes(*v);
@@ -212,12 +214,13 @@ std::string formatDistance(double d) {
 }  // namespace
 
 int runBench(const Argv& argv) {
-    const Args args(argv,
-                    {"--grid", "--tf", "--size", "--runs", "--warmup", "--threads", "--modes", "--distances",
-                     "--threshold", "--lod", "--simd", "--footprint", "--filter-order", "--subpixels", "--json", "--view-dir", "--up"},
-                    {"-v"});
+    std::set<std::string> valueFlags{"--grid",      "--tf",  "--size", "--runs",      "--warmup", "--threads",
+                                     "--modes",     "--distances", "--threshold", "--lod", "--simd",
+                                     "--footprint", "--filter-order", "--subpixels", "--json", "--view-dir", "--up"};
+    valueFlags.insert(shadingValueFlags().begin(), shadingValueFlags().end());
+    const Args args(argv, valueFlags, {"-v"});
     if (args.wantsHelp()) {
-        std::cout << kHelp;
+        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp;
         return 0;
     }
     const Options o = optionsFrom(args);

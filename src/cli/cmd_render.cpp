@@ -101,7 +101,7 @@ int runRender(const Argv& argv) {
     valueFlags.insert({"-o", "--stats"});
     const Args args(argv, valueFlags, {"-v", "--show-primitives"});
     if (args.wantsHelp()) {
-        std::cout << kHelp;
+        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp;
         return 0;
     }
     const std::string input = args.onePositional("input .vdb file");

@@ -10,8 +10,55 @@ const std::set<std::string>& renderValueFlags() {
     static const std::set<std::string> flags{"--grid",   "--mode",      "--size",      "--tf",    "--eye",
                                              "--look-at", "--up",       "--view-dir",  "--fov",   "--distance",
                                              "--threads", "--spp",      "--threshold", "--lod",   "--footprint",
-                                             "--tables",  "--simd", "--max-voxels", "--filter-order", "--subpixels"};
+                                             "--tables",  "--simd", "--max-voxels", "--filter-order", "--subpixels", "--shading",
+                                             "--ambient", "--diffuse",  "--specular",  "--shininess",
+                                             "--light",   "--gradient-opacity"};
     return flags;
+}
+
+const std::set<std::string>& shadingValueFlags() {
+    static const std::set<std::string> flags{"--shading",   "--ambient", "--diffuse",         "--specular",
+                                             "--shininess", "--light",   "--gradient-opacity"};
+    return flags;
+}
+
+const char* const kShadingHelp =
+    "  --shading S        off (default) | phong | ct: gradient-based Blinn-Phong, computed per voxel\n"
+    "                     before rendering (every mode, the reference too); ct: phong with the CT\n"
+    "                     preset (ambient 0.25, diffuse 0.75, specular 0.35, shininess 24)\n"
+    "  --ambient K        ambient coefficient in [0, 1] (default 0.3; needs --shading)\n"
+    "  --diffuse K        diffuse coefficient in [0, 1] (default 0.7; needs --shading)\n"
+    "  --specular K       specular coefficient in [0, 1] (default 0.2; needs --shading)\n"
+    "  --shininess P      specular exponent in [1, 1000] (default 20; needs --shading)\n"
+    "  --light X,Y,Z      directional light, world direction towards the light (default: a\n"
+    "                     headlight at the eye; needs --shading)\n"
+    "  --gradient-opacity K  scale each voxel's extinction by 1 - exp(-K |grad|), |grad| in\n"
+    "                     normalised value per voxel (default 0: off; see docs/shading.md)\n";
+
+ShadingSettings shadingFromFlags(const Args& args) {
+    ShadingSettings s;
+    if (auto v = args.get("--shading")) {
+        if (*v == "ct") s = ShadingSettings::ctPreset();
+        else if (*v == "phong") s.mode = ShadingMode::Phong;
+        else if (*v != "off") throw Error("--shading: expected 'off', 'phong' or 'ct', got '" + *v + "'");
+    }
+    for (const char* flag : {"--ambient", "--diffuse", "--specular", "--shininess", "--light"})
+        if (args.has(flag) && s.mode == ShadingMode::Off)
+            throw Error(std::string(flag) + ": needs --shading phong or ct");
+    const auto number = [&](const char* flag, float& to) {
+        if (auto v = args.get(flag)) to = float(parseDouble(*v, flag));
+    };
+    number("--ambient", s.ambient);
+    number("--diffuse", s.diffuse);
+    number("--specular", s.specular);
+    number("--shininess", s.shininess);
+    number("--gradient-opacity", s.gradientOpacity);
+    if (auto v = args.get("--light")) {
+        s.hasLight = true;
+        s.light = parseVec3(*v, "--light");
+    }
+    s.validate();
+    return s;
 }
 
 glm::dvec3 parseVec3(const std::string& text, const std::string& flag) {
@@ -40,6 +87,7 @@ RenderSettings settingsFromFlags(const Args& args) {
         s.simd = *v == "on";
     }
     s.showPrimitives = args.has("--show-primitives");
+    s.shading = shadingFromFlags(args);
     if (auto v = args.get("--tables")) {
         if (v->empty()) throw Error("--tables: expected a directory, got ''");
         s.tablesDir = *v;

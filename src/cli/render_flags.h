@@ -1,7 +1,7 @@
 // cli/render_flags.h — the render flags shared by `vdbsplat render` and `vdbsplat animate`.
 // Owns: turning --mode, --size, --tf, --grid, --fov, --distance, --threads, --spp,
-// --threshold, --footprint, --filter-order, --subpixels, --lod, --simd, --show-primitives, --tables, --up, --view-dir, --eye and
-// --look-at into validated RenderSettings, the same way for every command that renders
+// --threshold, --footprint, --filter-order, --subpixels, --lod, --simd, --show-primitives, --tables, --up,
+// --view-dir, --eye, --look-at and the shading flags into validated RenderSettings, the same way for every command that renders
 // (a command that does not declare a flag never sees it: Args refuses it first).
 #pragma once
 #include <glm/glm.hpp>
@@ -17,6 +17,17 @@ namespace vdbsplat::cli {
 
 /// The value flags settingsFromFlags() reads (without -o and command-specific ones).
 const std::set<std::string>& renderValueFlags();
+
+/// The shading flags (--shading, --ambient, --diffuse, --specular, --shininess, --light,
+/// --gradient-opacity), part of renderValueFlags(); `bench` adds them to its own set.
+const std::set<std::string>& shadingValueFlags();
+
+/// Help lines for the shading flags, shared by render, animate and bench.
+extern const char* const kShadingHelp;
+
+/// @brief The validated shading settings the shading flags in @p args describe.
+/// @throw Error naming the first bad flag (a bad value, or a lighting flag without --shading).
+ShadingSettings shadingFromFlags(const Args& args);
 
 /// @brief "X,Y,Z" → vector; @throw Error naming @p flag.
 glm::dvec3 parseVec3(const std::string& text, const std::string& flag);

@@ -26,13 +26,13 @@ struct ForwardPass {
 /// Streams, projects and composites @p volume onto @p camera's pixels.
 Image composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, const Tables& tables,
                 const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
-                const RenderControl& control) {
+                const VoxelShader* shader, const RenderControl& control) {
     StreamOptions streamOptions = settings.stream;
     streamOptions.lodCellPx = pass.lodPx;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point   ? INFINITY
                                  : settings.mode == RenderMode::Splat ? 0.0
                                                                       : pass.threshold;
-    VoxelStream stream(volume, camera, table, streamOptions);
+    VoxelStream stream(volume, camera, table, streamOptions, shader);
     TileCompositor compositor(camera.width(), camera.height(), tables,
                               ExactContext{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance});
     const ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
@@ -81,10 +81,10 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
 
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     const Tables& tables, const RenderSettings& settings, RenderStats& stats,
-                    const RenderControl& control) {
+                    const VoxelShader* shader, const RenderControl& control) {
     if (settings.filterOrder == FilterOrder::Prefilter)
         return composite(volume, table, camera, tables, settings,
-                         ForwardPass{settings.threshold, settings.lodPx, kPrefilterVariance}, stats, control);
+                         ForwardPass{settings.threshold, settings.lodPx, kPrefilterVariance}, stats, shader, control);
     // Postfilter: the same primitives (τ and the level of detail scaled to sub-pixels, so the
     // same voxels are points), composited at k× the resolution with only V_s folded in, then
     // the rest of the low-pass on the composited image (postfilter.h).
@@ -92,7 +92,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     const Camera fine = subpixelCamera(camera, grid);
     const double k = grid.k;
     const Image sub = composite(volume, table, fine, tables, settings,
-                                ForwardPass{settings.threshold * k, settings.lodPx * k, grid.fineVariance}, stats, control);
+                                ForwardPass{settings.threshold * k, settings.lodPx * k, grid.fineVariance}, stats, shader, control);
     return postfilterImage(sub, grid, camera.width(), camera.height());
 }
 

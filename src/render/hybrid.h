@@ -7,6 +7,7 @@
 #include "footprint/tables.h"
 #include "image/image.h"
 #include "render/settings.h"
+#include "shading/shading_field.h"
 #include "volume/grid.h"
 #include "volume/transfer_function.h"
 
@@ -15,6 +16,6 @@ namespace vdbsplat {
 /// @brief Renders @p volume in settings.mode (Hybrid, Splat or Point).
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     const Tables& tables, const RenderSettings& settings, RenderStats& stats,
-                    const RenderControl& control = {});
+                    const VoxelShader* shader = nullptr, const RenderControl& control = {});
 
 }  // namespace vdbsplat

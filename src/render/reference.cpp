@@ -115,8 +115,11 @@ ActiveRegions::ActiveRegions(const openvdb::FloatGrid& grid) {
     for (const auto& [key, box] : regions) boxes_.push_back(box);
 }
 
-RayIntegrator::RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions)
-    : volume_(volume), table_(table), accessor_(volume.grid->getConstAccessor()), bins_(kRingSize),
+RayIntegrator::RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions,
+                             const ShadingField* shading)
+    : volume_(volume), table_(table), accessor_(volume.grid->getConstAccessor()),
+      shading_(shading ? std::make_unique<ShadingField::Accessor>(shading->tree()) : nullptr),
+      bins_(kRingSize),
       ownRegions_(regions ? nullptr : std::make_unique<ActiveRegions>(*volume.grid)),
       regions_(regions ? regions : ownRegions_.get()) {}
 
@@ -213,7 +216,7 @@ void RayIntegrator::gather(const glm::dvec3& o, const glm::dvec3& d, double tEnt
                     if (rho2 >= kR * kR) continue;
                     float value;
                     if (!accessor_.probeValue(ijk, value)) continue;
-                    visit.kernel(tc, rho2, value);
+                    visit.kernel(tc, rho2, classify(ijk, value));
                 }
             }
             if (k == kLast) return;
@@ -224,13 +227,17 @@ void RayIntegrator::gather(const glm::dvec3& o, const glm::dvec3& d, double tEnt
     }
 }
 
+Classified RayIntegrator::classify(const openvdb::Coord& ijk, float value) {
+    const Classified cls = table_(value);
+    return shading_ ? applyShading(cls, shading_->getValue(ijk)) : cls;
+}
+
 namespace {
 
 /// The per-ray state of the bin compositor: a ring of depth bins from tEnter on, composited
 /// front to back as the slice front passes them (DESIGN §4: C += T·α·c, T *= 1 − α).
 struct BinCompositor {
     std::vector<RayIntegrator::Bin>& bins;
-    const ClassificationTable& table;
     double tEnter;
     glm::dvec3 color{0.0};
     double transmittance = 1.0;
@@ -252,8 +259,7 @@ struct BinCompositor {
     }
 
     /// Deposits one kernel's exact line integral, bin by bin: τ_bin = σ_k ∫_bin g dt (erf).
-    void kernel(double tc, double rho2, float value) {
-        const Classified cls = table(value);
+    void kernel(double tc, double rho2, const Classified& cls) {
         if (!(cls.sigma > 0.f)) return;
         const ErfTable& E = erfTable();
         const double halfChord = std::sqrt(kR * kR - rho2);
@@ -296,7 +302,7 @@ glm::dvec4 RayIntegrator::integrate(const glm::dvec3& origin, const glm::dvec3& 
     double tEnter, tExit;
     if (!clip(o, d, tEnter, tExit)) return glm::dvec4(0.0);
     std::fill(bins_.begin(), bins_.end(), Bin{});
-    BinCompositor compositor{bins_, table_, tEnter};
+    BinCompositor compositor{bins_, tEnter};
     gather(o, d, tEnter, tExit, compositor);
     compositor.compositeUpTo(compositor.filled + 1);
     return glm::dvec4(compositor.color, 1.0 - compositor.transmittance);
@@ -310,8 +316,7 @@ double RayIntegrator::opticalDepth(const glm::dvec3& origin, const glm::dvec3& d
     struct Visitor {
         RayIntegrator* self;
         double tEnter, sum = 0.0;
-        void kernel(double tc, double rho2, float value) {
-            const Classified cls = self->table_(value);
+        void kernel(double tc, double rho2, const Classified& cls) {
             sum += cls.sigma * Kernel::segmentIntegral(std::sqrt(rho2), tEnter - tc, kR);
         }
         bool sliceDone(double) { return true; }
@@ -321,7 +326,7 @@ double RayIntegrator::opticalDepth(const glm::dvec3& origin, const glm::dvec3& d
 }
 
 Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
-                      RenderStats& stats, const RenderControl& control) {
+                      RenderStats& stats, const ShadingField* shading, const RenderControl& control) {
     const auto start = std::chrono::steady_clock::now();
     const int n = std::max(1, int(std::ceil(std::sqrt(double(spp)) - 1e-9)));  // strata per axis
     stats.raysPerPixel = n * n;
@@ -353,7 +358,7 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
             return PixelCoord(px + (sx + hash01(px, py, 2 * s)) / n, py + (sy + hash01(px, py, 2 * s + 1)) / n);
         };
         tbb::parallel_for(tbb::blocked_range<int>(0, sh, 1), [&](const tbb::blocked_range<int>& rows) {
-            RayIntegrator integrator(volume, table, &regions);
+            RayIntegrator integrator(volume, table, &regions, shading);
             for (int r = rows.begin(); r < rows.end(); ++r) {
                 if (stopped.load(std::memory_order_relaxed) || (control.stop && control.stop())) {
                     stopped.store(true);

@@ -24,6 +24,7 @@
 #include "camera/camera.h"
 #include "image/image.h"
 #include "render/settings.h"
+#include "shading/shading_field.h"
 #include "volume/grid.h"
 #include "volume/transfer_function.h"
 
@@ -52,7 +53,9 @@ class RayIntegrator {
 public:
     /// @p regions: the volume's ActiveRegions, shared by every integrator of a render; when
     /// null the integrator builds its own.
-    RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions = nullptr);
+    /// @p shading: per-voxel shading factors applied after classification (nullptr: none).
+    RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions = nullptr,
+                  const ShadingField* shading = nullptr);
     /// @brief Premultiplied RGB and alpha = 1 − T of the ray from world point @p origin
     /// along world direction @p direction (any length), from the origin to infinity.
     glm::dvec4 integrate(const glm::dvec3& origin, const glm::dvec3& direction);
@@ -65,6 +68,8 @@ public:
 private:
     template <typename Visit> void gather(const glm::dvec3& oIdx, const glm::dvec3& dIdx, double tEnter, double tExit,
                                           Visit&& visit);
+    /// The voxel's classification, shaded when the integrator has a shading field.
+    Classified classify(const openvdb::Coord& ijk, float value);
     bool clip(const glm::dvec3& oIdx, const glm::dvec3& dIdx, double& tEnter, double& tExit) const;
     /// A run of slice indices [first, last] along the major axis.
     struct SliceRange { int64_t first, last; };
@@ -76,6 +81,7 @@ private:
     const Volume& volume_;
     const ClassificationTable& table_;
     openvdb::FloatGrid::ConstAccessor accessor_;
+    std::unique_ptr<ShadingField::Accessor> shading_;  ///< null when unshaded
     std::vector<Bin> bins_;
     std::unique_ptr<ActiveRegions> ownRegions_;
     const ActiveRegions* regions_;
@@ -89,6 +95,7 @@ private:
 /// @param control progress (fraction of sample rows traced) and stop (polled per sample row).
 /// @throw RenderStopped when control.stop returned true.
 Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
-                      RenderStats& stats, const RenderControl& control = {});
+                      RenderStats& stats, const ShadingField* shading = nullptr,
+                      const RenderControl& control = {});
 
 }  // namespace vdbsplat

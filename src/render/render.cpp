@@ -3,10 +3,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 
 #include "footprint/tables.h"
 #include "render/hybrid.h"
 #include "render/reference.h"
+#include "shading/shading_field.h"
 #include "util/error.h"
 
 namespace vdbsplat {
@@ -62,15 +64,29 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     const ClassificationTable table = tf.bake(lo, hi, volume.voxelSize);
     const Camera camera = cameraFor(volume, settings);
     stats.activeVoxels = volume.activeVoxels;
+    // Shading (docs/shading.md): one VoxelShader for every mode. The reference reads each voxel
+    // many times and takes the whole field, computed once; the forward modes shade the voxels
+    // they draw as the stream classifies them.
+    std::unique_ptr<VoxelShader> shader;
+    if (settings.shading.active())
+        shader = std::make_unique<VoxelShader>(volume, table, lo, hi, camera.eye(), settings.shading);
     Image image;
     switch (settings.mode) {
-        case RenderMode::Reference: image = renderReference(volume, table, camera, settings.spp, stats, control); break;
+        case RenderMode::Reference: {
+            std::unique_ptr<ShadingField> field;
+            if (shader) {
+                field = std::make_unique<ShadingField>(*shader);
+                stats.shadingSeconds = field->seconds();
+            }
+            image = renderReference(volume, table, camera, settings.spp, stats, field.get(), control);
+            break;
+        }
         case RenderMode::Hybrid:
         case RenderMode::Splat:
         case RenderMode::Point: {
             const Tables tables =
                 loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir));
-            image = renderForward(volume, table, camera, tables, settings, stats, control);
+            image = renderForward(volume, table, camera, tables, settings, stats, shader.get(), control);
             break;
         }
     }

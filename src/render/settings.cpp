@@ -42,6 +42,7 @@ void RenderSettings::validate() const {
         throw Error("--subpixels: must be in [1, " + std::to_string(kMaxSubpixels) + "]");
     if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
         throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
+    shading.validate();
     if (!tablesDir.empty()) {
         std::error_code ec;
         if (!std::filesystem::is_directory(tablesDir, ec))
@@ -102,6 +103,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["lod"] = lodPx;
     j["simd"] = simd;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
+    if (shading.active()) j["shading"] = shading.toJson();  // absent when off: unshaded outputs unchanged
     return j;
 }
 
@@ -126,6 +128,7 @@ nlohmann::json RenderStats::toJson() const {
     if (raysPerPixel) j["rays_per_pixel"] = raysPerPixel;
     j["stage_seconds"] = {{"stream", streamSeconds}, {"project", projectSeconds},
                           {"rasterize", rasterizeSeconds}, {"composite", compositeSeconds}};
+    if (shadingSeconds > 0.0) j["stage_seconds"]["shading"] = shadingSeconds;
     return j;
 }
 

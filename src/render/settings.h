@@ -9,6 +9,7 @@
 
 #include "camera/camera.h"
 #include "util/error.h"
+#include "shading/shading.h"
 #include "volume/stream.h"
 
 namespace vdbsplat {
@@ -79,6 +80,7 @@ struct RenderSettings {
     std::string tablesDir;                  ///< footprint/reindex tables; empty: defaultTablesDir()
     StreamOptions stream;                   ///< how the grid is streamed: speed and memory, never the image
     uint64_t maxActiveVoxels = kDefaultMaxActiveVoxels;  ///< larger grids are refused before any work
+    ShadingSettings shading;                ///< off by default: the unshaded emission–absorption image
 
     /// @throw Error naming the flag of the first invalid value (--tables: DIR must be a directory).
     void validate() const;
@@ -116,6 +118,7 @@ struct RenderStats {
     uint64_t largestWindow = 0;       ///< forward modes: most voxels in one window
     uint64_t rays = 0;  ///< reference: rays traced
     int raysPerPixel = 0;  ///< reference: the --spp actually used (rounded up to a square)
+    double shadingSeconds = 0.0;  ///< the shading pass (0 when shading is off)
     double streamSeconds = 0.0, projectSeconds = 0.0, rasterizeSeconds = 0.0, compositeSeconds = 0.0;
     nlohmann::json toJson() const;
 };

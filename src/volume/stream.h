@@ -27,6 +27,8 @@
 
 namespace vdbsplat {
 
+class VoxelShader;  // shading/shading_field.h
+
 /// @brief One depth window of voxels, structure of arrays, in a deterministic order.
 struct VoxelBatch {
     std::vector<glm::vec3> viewPos;  ///< voxel centre in view space (eye at origin, +z forward)
@@ -73,8 +75,9 @@ class VoxelStream {
 public:
     /// @brief Streams @p volume for @p camera; @p table classifies values.
     /// @throw Error when the grid is too large to stream (more than 2^32 active voxels).
+    /// @p shader: shades each voxel after classification (nullptr: unshaded; docs/shading.md).
     VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
-                const StreamOptions& options = {});
+                const StreamOptions& options = {}, const VoxelShader* shader = nullptr);
 
     /// @brief Fills @p batch with the next window front to back; false when the stream is done.
     /// @param hidden optional: returns true for a block whose screen rectangle (pixels,
@@ -112,6 +115,7 @@ private:
     const Camera& camera_;
     const ClassificationTable& table_;
     StreamOptions options_;
+    const VoxelShader* shader_;
     double slabLength_;
     std::vector<Block> blocks_;   // sorted by dMin
     size_t nextBlock_ = 0;

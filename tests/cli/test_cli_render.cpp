@@ -290,6 +290,27 @@ TEST_F(CliRender, BadFlagValues) {
     });
 }
 
+// Every shading value: NaN, negative, out of range, malformed, or a lighting flag without --shading.
+TEST_F(CliRender, BadShadingFlags) {
+    const std::string s = vdb("sphere.vdb");
+    expectAllFail({
+        {s, {"--shading", "gouraud"}, "--shading: expected 'off', 'phong' or 'ct', got 'gouraud'", kAllModes, kParsing},
+        {s, {"--shading", "phong", "--ambient", "nan"}, "--ambient", kAllModes, kParsing},
+        {s, {"--shading", "phong", "--ambient", "-0.1"}, "--ambient: must be a number in [0, 1]", kAllModes, kParsing},
+        {s, {"--shading", "phong", "--diffuse", "1.5"}, "--diffuse: must be a number in [0, 1]", kAllModes, kParsing},
+        {s, {"--shading", "ct", "--specular", "x"}, "--specular", kAllModes, kParsing},
+        {s, {"--shading", "phong", "--shininess", "0"}, "--shininess: must be a number in [1, 1000]", kAllModes, kParsing},
+        {s, {"--shading", "phong", "--shininess", "1e40"}, "--shininess", kAllModes, kParsing},
+        {s, {"--shading", "phong", "--light", "0,0,0"}, "--light: must be a non-zero direction", kAllModes, kParsing},
+        {s, {"--shading", "phong", "--light", "1,2"}, "--light", kAllModes, kParsing},
+        {s, {"--shading", "phong", "--light", "inf,0,1"}, "--light", kAllModes, kParsing},
+        {s, {"--ambient", "0.5"}, "--ambient: needs --shading phong or ct", kAllModes, kParsing},
+        {s, {"--shading", "off", "--light", "0,0,1"}, "--light: needs --shading phong or ct", kAllModes, kParsing},
+        {s, {"--gradient-opacity", "-1"}, "--gradient-opacity: must be a number in [0, 1e6]", kAllModes, kParsing},
+        {s, {"--gradient-opacity", "1e300"}, "--gradient-opacity", kAllModes, kParsing},
+    });
+}
+
 TEST_F(CliRender, BadCameras) {
     const std::string s = vdb("sphere.vdb");
     expectAllFail({
