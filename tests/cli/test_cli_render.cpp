@@ -503,7 +503,7 @@ void interruptRender(const std::string& input, const fs::path& dir, int sig, boo
     const std::string image = (dir / "out.png").string(), outPath = (dir / "o.txt").string(),
                       errPath = (dir / "e.txt").string();
     std::vector<std::string> args{"render", input, "-o", image, "--mode", "reference", "--spp", "1024",
-                                  "--size", "400x400", "--threads", "1"};
+                                  "--size", "200x200", "--threads", "1"};
     if (verbose) args.push_back("-v");
     const pid_t pid = test::spawnVdbsplat(args, outPath, errPath);
     ASSERT_GT(pid, 0);
