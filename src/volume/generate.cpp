@@ -582,7 +582,11 @@ std::vector<TubePrimitive> tubeLayout(int res, int count, int sheets, double rad
         TubePrimitive t;
         t.a = inBox(1), t.b = inBox(1);
         for (int tries = 0; tries < 64 && (t.b - t.a).length() < kTubeMinLengthFraction * res; ++tries) t.b = inBox(1);
-        const openvdb::Vec3d bend(u(2) - 0.5, u(2) - 0.5, u(2) - 0.5);
+        // One draw per statement: the order in which a constructor's arguments are evaluated is
+        // unspecified (GCC and clang differ), and each draw advances the counter. z, y, x is
+        // the order of the catalogued layout (34 740 voxels).
+        const double bz = u(2), by = u(2), bx = u(2);
+        const openvdb::Vec3d bend(bx - 0.5, by - 0.5, bz - 0.5);
         t.m = 0.5 * (t.a + t.b) + 2.0 * kTubeBendFraction * res * bend;
         t.m = openvdb::Vec3d(std::clamp(t.m.x(), lo, hi), std::clamp(t.m.y(), lo, hi), std::clamp(t.m.z(), lo, hi));
         t.r = radiusMin + u(3) * (radiusMax - radiusMin);
@@ -592,7 +596,8 @@ std::vector<TubePrimitive> tubeLayout(int res, int count, int sheets, double rad
         TubePrimitive s;
         s.sheet = true;
         const double mid = 0.5 * (res - 1), spread = 0.2 * (res - 1);
-        s.a = openvdb::Vec3d(mid + spread * (2.0 * u(4) - 1.0), mid + spread * (2.0 * u(4) - 1.0), mid + spread * (2.0 * u(4) - 1.0));
+        const double az = u(4), ay = u(4), ax = u(4);  // one draw per statement, as above
+        s.a = openvdb::Vec3d(mid + spread * (2.0 * ax - 1.0), mid + spread * (2.0 * ay - 1.0), mid + spread * (2.0 * az - 1.0));
         // A uniform direction: z uniform in [−1, 1], azimuth uniform (Archimedes).
         const double z = 2.0 * u(5) - 1.0, phi = 2.0 * std::numbers::pi * u(5), rxy = std::sqrt(std::max(0.0, 1.0 - z * z));
         s.n = openvdb::Vec3d(rxy * std::cos(phi), rxy * std::sin(phi), z);
