@@ -10,6 +10,8 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "composite/opacity.h"
 #include "composite/splat_raster.h"
@@ -63,23 +65,8 @@ Image TileCompositor::image() const {
 
 SkippedPrimitives TileCompositor::composite(std::span<const Primitive> prims, double& binSeconds, double& compositeSeconds) {
     const auto t0 = Clock::now();
-    int64_t slabBase = std::numeric_limits<int64_t>::max();
-    for (const Primitive& p : prims)
-        if (p.kind != PrimitiveKind::Culled) slabBase = std::min(slabBase, p.slab);
-    // One global sort by (key, index), then a gather: every tile's list comes out in
-    // order without a per-tile sort, and the tiles read their primitives sequentially
-    // (indexing the window in key order was a cache miss per primitive at far views).
-    order_.clear();
-    for (uint32_t i = 0; i < prims.size(); ++i) {
-        const Primitive& p = prims[i];
-        if (p.kind != PrimitiveKind::Culled && !p.range.empty()) order_.push_back({sortKey(p, slabBase), i});
-    }
-    tbb::parallel_sort(order_.begin(), order_.end());  // a total order: the result is unique
-    if (sorted_.size() < order_.size()) sorted_.resize(order_.size());  // grows only: no per-window construction
-    sortedCount_ = order_.size();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, order_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t k = r.begin(); k < r.end(); ++k) sorted_[k] = prims[order_[k].index];
-    });
+    window_ = prims;
+    sortWindow(prims);
     const SkippedPrimitives skipped = binToTiles();
     binSeconds += since(t0);
     const auto t1 = Clock::now();
@@ -91,21 +78,68 @@ SkippedPrimitives TileCompositor::composite(std::span<const Primitive> prims, do
         }
     });
     compositeSeconds += since(t1);
+    window_ = {};
     return skipped;
 }
 
-/// Bins sorted_ into per-tile lists (CSR: binStart_, binEntries_), each list ascending in
-/// sorted_ position, skipping tiles that are already opaque. Parallel over fixed chunks of
-/// sorted_: count per (chunk, tile), prefix sums, fill; the lists do not depend on the chunking.
+/// One global sort by (key, index), then a gather: every tile's list comes out in order
+/// without a per-tile sort, and the tiles read their primitives sequentially (indexing the
+/// window in key order was a cache miss per primitive at far views). Every pass is parallel
+/// over fixed chunks of the window, so the result does not depend on the thread count; what
+/// is gathered is the 64-byte TileRecord, not the Primitive.
+void TileCompositor::sortWindow(std::span<const Primitive> prims) {
+    const size_t n = prims.size();
+    const size_t chunks = std::clamp<size_t>(n / 16384, 1, 64), per = (n + chunks - 1) / chunks;
+    const auto drawable = [](const Primitive& p) { return p.kind != PrimitiveKind::Culled && !p.range.empty(); };
+    // Per chunk: drawable primitives and their lowest slab (the key's slab is relative to it).
+    std::vector<size_t>& count = chunkCounts_;
+    count.assign(chunks + 1, 0);
+    std::vector<int64_t> lowest(chunks, std::numeric_limits<int64_t>::max());
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+        for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i)
+            if (drawable(prims[i])) ++count[c], lowest[c] = std::min(lowest[c], prims[i].slab);
+    });
+    const int64_t slabBase = *std::min_element(lowest.begin(), lowest.end());
+    size_t total = 0;
+    for (size_t c = 0; c <= chunks; ++c) total += std::exchange(count[c], total);  // count[c]: chunk c's cursor
+    order_.resize(total);
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+        size_t cursor = count[c];
+        for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i)
+            if (drawable(prims[i])) order_[cursor++] = {sortKey(prims[i], slabBase), uint32_t(i)};
+    });
+    tbb::parallel_sort(order_.begin(), order_.end());  // a total order: the result is unique
+    if (records_.size() < total) records_.resize(total), maps_.resize(total);  // grow only: no per-window construction
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, total, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k < r.end(); ++k) {
+            const Primitive& p = prims[order_[k].index];
+            TileRecord& q = records_[k];
+            q.centre = p.centre;
+            q.shape = p.kind == PrimitiveKind::Point ? glm::vec3(p.variance, p.total, 0.f) : p.conic;
+            q.scale = p.scale, q.sin2Alpha = p.sin2Alpha;
+            q.color = p.color;
+            q.range = p.range;
+            q.slab = uint32_t(std::clamp<int64_t>(p.slab - slabBase, 0, std::numeric_limits<uint32_t>::max()));
+            q.kind = p.kind;
+            q.hasExactMap = p.hasExactMap;
+            if (p.hasExactMap) maps_[k] = p.exactMap;
+        }
+    });
+}
+
+/// Bins records_ into per-tile lists (CSR: binStart_, binEntries_), each list ascending in
+/// sorted position, skipping tiles that are already opaque. Parallel over fixed chunks of
+/// records_: count per (chunk, tile), prefix sums, fill; the lists do not depend on the chunking.
 SkippedPrimitives TileCompositor::binToTiles() {
-    const size_t tiles = size_t(tilesX_) * tilesY_, n = sortedCount_;
+    const size_t tiles = size_t(tilesX_) * tilesY_, n = order_.size();
     const size_t chunks = std::clamp<size_t>(n / 16384, 1, 16), per = (n + chunks - 1) / chunks;
     std::vector<uint32_t>& counts = binCounts_;  // reused: fresh pages cost a fault each on every window
     counts.assign(chunks * tiles, 0);
     std::vector<SkippedPrimitives> skippedIn(chunks);
-    const auto forTiles = [&](const Primitive& p, auto&& fn) {
-        for (int ty = p.range.y0 / kTileSize; ty <= p.range.y1 / kTileSize; ++ty)
-            for (int tx = p.range.x0 / kTileSize; tx <= p.range.x1 / kTileSize; ++tx) {
+    const auto forTiles = [&](const PixelRange& range, auto&& fn) {
+        const int tx0 = range.x0 / kTileSize, tx1 = range.x1 / kTileSize;
+        for (int ty = range.y0 / kTileSize; ty <= range.y1 / kTileSize; ++ty)
+            for (int tx = tx0; tx <= tx1; ++tx) {
                 const size_t tile = size_t(ty) * tilesX_ + tx;
                 if (liveCount_[tile] > 0) fn(tile);
             }
@@ -114,13 +148,13 @@ SkippedPrimitives TileCompositor::binToTiles() {
         uint32_t* count = counts.data() + c * tiles;
         SkippedPrimitives& skipped = skippedIn[c];
         for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k) {
-            const Primitive& p = sorted_[k];
+            const TileRecord& p = records_[k];
             bool any = false;
-            forTiles(p, [&](size_t tile) { ++count[tile], any = true; });
+            forTiles(p.range, [&](size_t tile) { ++count[tile], any = true; });
             if (!any) {
                 ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
                 if (p.kind == PrimitiveKind::SplatExactIndex) ++skipped.exactIndexSplats;
-                skipped.voxels += p.members;
+                skipped.voxels += window_[order_[k].index].members;
             }
         }
     });
@@ -140,7 +174,7 @@ SkippedPrimitives TileCompositor::binToTiles() {
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         uint32_t* cursor = counts.data() + c * tiles;
         for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k)
-            forTiles(sorted_[k], [&](size_t tile) { binEntries_[cursor[tile]++] = uint32_t(k); });
+            forTiles(records_[k].range, [&](size_t tile) { binEntries_[cursor[tile]++] = uint32_t(k); });
     });
     SkippedPrimitives skipped;
     for (const SkippedPrimitives& s : skippedIn) {
@@ -208,10 +242,13 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
             }
         slab.dirty = false;
     };
+    constexpr size_t kAhead = 8;  // records are a cache miss each (a tile's list is sparse in records_)
     for (size_t e = 0; e < entries.size(); ++e) {
-        const Primitive& p = sorted_[entries[e]];
+        if (e + kAhead < entries.size()) __builtin_prefetch(&records_[entries[e + kAhead]]);
+        const uint32_t k = entries[e];
+        const TileRecord& p = records_[k];
         const bool isPoint = p.kind == PrimitiveKind::Point;
-        if (p.slab != slabOf || !isPoint) {
+        if (int64_t(p.slab) != slabOf || !isPoint) {
             flush();
             slabOf = p.slab;
         }
@@ -219,10 +256,12 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
         if ((e & 31) == 31 && !slab.dirty && px.countLive() == 0) break;
         switch (p.kind) {
             case PrimitiveKind::Point: drawPoint(p, px, slab); break;
-            case PrimitiveKind::Splat:
-            case PrimitiveKind::SplatExactIndex: drawSplat(p, px); break;
+            case PrimitiveKind::Splat: drawSplat(p, maps_[k], px); break;
+            case PrimitiveKind::SplatExactIndex:  // without its map: the half-ray fallback
+                p.hasExactMap ? drawSplat(p, maps_[k], px) : drawExact(window_[order_[k].index], px);
+                break;
             case PrimitiveKind::SplatExact:
-            case PrimitiveKind::NearEye: drawExact(p, px); break;
+            case PrimitiveKind::NearEye: drawExact(window_[order_[k].index], px); break;
             case PrimitiveKind::Culled: break;
         }
     }
@@ -236,32 +275,32 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
     liveCount_[tile] = px.countLive();
 }
 
-void TileCompositor::drawPoint(const Primitive& p, const TilePixels& px, SlabBuffer& slab) const {
-    const PointFootprint fp = rasterizePoint(pointFilter_, PixelCoord(p.centre), p.variance);
+void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBuffer& slab) const {
+    const float variance = p.shape.x, total = p.shape.y;
+    const PointFootprint fp = rasterizePoint(pointFilter_, PixelCoord(p.centre), variance);
     const int x0 = std::max(fp.x0, px.x0), x1 = std::min(fp.x0 + fp.nx - 1, px.x1);
     const int y0 = std::max(fp.y0, px.y0), y1 = std::min(fp.y0 + fp.ny - 1, px.y1);
     for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
             const int i = px.local(x, y);
             if (!px.live(i)) continue;
-            const float tau = p.total * fp.at(x - fp.x0, y - fp.y0);
+            const float tau = total * fp.at(x - fp.x0, y - fp.y0);
             slab.tau[size_t(i)] += tau;
             slab.emission[size_t(i)] += tau * p.color;
         }
     slab.dirty = true;
 }
 
-void TileCompositor::drawSplat(const Primitive& p, TilePixels& px) const {
+void TileCompositor::drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& px) const {
     const bool exactIndex = p.kind == PrimitiveKind::SplatExactIndex;
-    if (exactIndex && !p.hasExactMap) return drawExact(p, px);  // borderline in float: the half-ray fallback
     if (exact_.vector && (exactIndex || tables_.poly.covers(p.sin2Alpha))) {
         SplatRaster s;
         s.cx = p.centre.x, s.cy = p.centre.y;
-        s.qxx = p.conic.x, s.qxy = p.conic.y, s.qyy = p.conic.z;
+        s.qxx = p.shape.x, s.qxy = p.shape.y, s.qyy = p.shape.z;
         s.scale = p.scale;
         s.coef = exactIndex ? tables_.poly.axisRow() : tables_.poly.row(p.sin2Alpha);
         s.exactIndex = exactIndex;
-        s.map = p.exactMap;
+        if (exactIndex) s.map = map;
         s.color = p.color;
         s.x0 = std::max(p.range.x0, px.x0), s.x1 = std::min(p.range.x1, px.x1);
         s.y0 = std::max(p.range.y0, px.y0), s.y1 = std::min(p.range.y1, px.y1);
@@ -269,21 +308,20 @@ void TileCompositor::drawSplat(const Primitive& p, TilePixels& px) const {
         drawSplatVector(s, px.buffers());
         return;
     }
-    drawSplatTables(p, px);
+    drawSplatTables(p, map, px);
 }
 
-void TileCompositor::drawSplatTables(const Primitive& p, TilePixels& px) const {
+void TileCompositor::drawSplatTables(const TileRecord& p, const ExactIndexMap& map, TilePixels& px) const {
     // SplatExactIndex (--footprint auto, far off the axis): the exact index d instead of the
     // affine one, from the affine map set up once at projection (ExactIndexMap).
     const bool exactIndex = p.kind == PrimitiveKind::SplatExactIndex;
-    const ExactIndexMap& map = p.exactMap;
     SplatShader shader;  // the table path's per-splat state (screen_kernel.h)
-    shader.row = tables_.reindex.row(p.alpha);
+    shader.row = tables_.reindex.row(halfConeAngle(p.sin2Alpha));
     shader.footprint = &tables_.footprint;
     shader.scale = p.scale;
     const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
     const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
-    const float qxx = p.conic.x, qxy = p.conic.y, qyy = p.conic.z;
+    const float qxx = p.shape.x, qxy = p.shape.y, qyy = p.shape.z;
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y) + 0.5f - p.centre.y;
         // The row's chord of the support ellipse, i² < 1:  qxx dx² + 2 qxy dy dx + qyy dy² − 1 < 0.

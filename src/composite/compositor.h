@@ -22,6 +22,7 @@
 #include "footprint/tables.h"
 #include "image/image.h"
 #include "pointfilter/point_filter.h"
+#include "util/huge_pages.h"
 
 namespace vdbsplat {
 
@@ -67,27 +68,47 @@ private:
         uint32_t index;  // primitive index: the tie-break
         bool operator<(const Entry& o) const { return key != o.key ? key < o.key : index < o.index; }
     };
+    /// What the tile loop reads of one primitive, gathered in sort order: one 64-byte line
+    /// instead of the projection's ~200-byte Primitive (gsplat: sort keys, not records).
+    /// The rare kinds that need more (SplatExact, NearEye) read the window's Primitive.
+    struct TileRecord {
+        glm::vec2 centre;      // point position / ellipse centre (pixels)
+        glm::vec3 shape;       // splat: conic (Qxx, Qxy, Qyy); point: (variance, total, 0)
+        float scale;           // splat: σ·h·amplitude
+        float sin2Alpha;       // splat: the polynomial's (or the reindex table's) row
+        glm::vec3 color;
+        PixelRange range;
+        uint32_t slab;         // relative to the window's first slab
+        PrimitiveKind kind;
+        bool hasExactMap;      // SplatExactIndex: maps_ holds its ExactIndexMap
+    };
+    static_assert(sizeof(TileRecord) == 64, "one cache line per primitive");
     struct SlabBuffer;
     struct TilePixels;  // one tile's transmittance and colour, copied in and out (thread-local)
+    void sortWindow(std::span<const Primitive> prims);
     SkippedPrimitives binToTiles();
     void compositeTile(int tile, std::span<const uint32_t> entries);
-    void drawPoint(const Primitive& p, const TilePixels& tile, SlabBuffer& slab) const;
-    void drawSplat(const Primitive& p, TilePixels& tile) const;
-    void drawSplatTables(const Primitive& p, TilePixels& tile) const;
+    void drawPoint(const TileRecord& p, const TilePixels& tile, SlabBuffer& slab) const;
+    void drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile) const;
+    void drawSplatTables(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile) const;
     void drawExact(const Primitive& p, TilePixels& tile) const;
 
     int width_, height_, tilesX_, tilesY_;
     const Tables& tables_;
     ExactContext exact_;
     PointFilterTable pointFilter_;
-    std::vector<glm::vec3> color_;        // premultiplied radiance
-    std::vector<float> transmittance_;
+    template <class T>
+    using Buffer = std::vector<T, HugePageAllocator<T>>;  // large: in huge pages (util/huge_pages.h)
+    Buffer<glm::vec3> color_;             // premultiplied radiance
+    Buffer<float> transmittance_;
     std::vector<int> liveCount_;          // per tile: pixels with T ≥ ε
-    std::vector<Entry> order_;            // the window's drawable primitives in (key, index) order
-    std::vector<Primitive> sorted_;       // ... gathered in that order (the first sortedCount_)
-    size_t sortedCount_ = 0;
+    std::span<const Primitive> window_;   // the window being composited (composite()'s argument)
+    Buffer<Entry> order_;            // the window's drawable primitives in (key, index) order
+    Buffer<TileRecord> records_;     // ... gathered in that order (the first order_.size())
+    Buffer<ExactIndexMap> maps_;     // ... their exact-index maps, where hasExactMap
+    std::vector<size_t> chunkCounts_;     // sortWindow's per-chunk counts and cursors
     std::vector<size_t> binStart_;        // per tile (+1): its list in binEntries_
-    std::vector<uint32_t> binEntries_;    // per tile: positions in sorted_, ascending
+    Buffer<uint32_t> binEntries_;    // per tile: positions in records_, ascending
     std::vector<uint32_t> binCounts_;     // binToTiles' per-(chunk, tile) counts and cursors
 };
 

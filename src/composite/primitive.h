@@ -5,11 +5,15 @@
 // ellipse widened by the low-pass, (i, α) reindex + footprint table), or a
 // near-eye kernel drawn with the exact half-ray integral (ellipse.h fallback).
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "footprint/pixel_box.h"
 #include "footprint/screen_kernel.h"
+#include "util/huge_pages.h"
 
 namespace vdbsplat {
 
@@ -37,8 +41,8 @@ struct Primitive {
     // Splat (table path)
     glm::vec3 conic{0.f};       ///< Q as (Qxx, Qxy, Qyy): i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²
     float scale = 0.f;          ///< σ_k·h·amplitude (SplatShader::scale)
-    float alpha = 0.f;          ///< half cone angle (the table path's reindex row)
-    float sin2Alpha = 0.f;      ///< sin²α (the vector loop's polynomial row)
+    float sin2Alpha = 0.f;      ///< sin²α: the vector loop's polynomial row, the table path's
+                                ///< reindex row through halfConeAngle()
     // SplatExactIndex: the exact d² as an affine map of the pixel (δ from `centre`), set up once
     ExactIndexMap exactMap;
     bool hasExactMap = false;
@@ -46,5 +50,12 @@ struct Primitive {
     glm::vec3 viewPos{0.f};
     float sigma = 0.f;          ///< extinction per voxel length
 };
+
+/// The projected window: reused window after window, in huge pages (util/huge_pages.h).
+using PrimitiveBuffer = std::vector<Primitive, HugePageAllocator<Primitive>>;
+
+/// @brief The half cone angle α = asin(sin α) of a splat from its stored sin²α (DESIGN §2):
+/// the table path's reindex row; the projection itself needs no trigonometry.
+inline double halfConeAngle(float sin2Alpha) { return std::asin(std::sqrt(std::clamp(double(sin2Alpha), 0.0, 1.0))); }
 
 }  // namespace vdbsplat

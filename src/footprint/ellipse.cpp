@@ -40,7 +40,7 @@ PixelBox sphereBounds(const SphereProjection& s) {
 ///   a = f·r·√(D² − r²)/(z² − r²), b = f·r/√(z² − r²), |centre − principal| = f·ρ·z/(z² − r²).
 void fillEllipse(SphereProjection& s) {
     const double z = s.c.z, r2 = s.r * s.r;
-    const double rhoXY = std::hypot(s.c.x, s.c.y);  // D·sinθ
+    const double rhoXY = s.rho;                      // D·sinθ
     const double q = z * z - r2;                     // D²·den
     s.u = rhoXY > 0.0 ? glm::dvec2(s.c.x, -s.c.y) / rhoXY : glm::dvec2(1.0, 0.0);  // y flip
     s.centre = s.principal + s.u * (s.f * rhoXY * z / q);
@@ -72,12 +72,12 @@ SphereProjection projectSphere(const ViewPoint& c, double r, double f, const Pix
         return s;  // Behind: culled, all fields zero
     s.c = c, s.r = r, s.f = f, s.principal = principal;
     s.D = glm::length(c);
-    s.theta = s.D > 0.0 ? std::acos(std::clamp(c.z / s.D, -1.0, 1.0)) : 0.0;
+    s.rho = std::hypot(c.x, c.y);
     if (s.D <= r) {
         s.kind = SphereClass::EyeInside;
-        s.alpha = std::numbers::pi / 2.0;
+        s.sinAlpha = 1.0;
     } else {
-        s.alpha = std::asin(r / s.D);
+        s.sinAlpha = r / s.D;  // α itself (asin) only on demand: alpha()
         const double den = (c.z * c.z - r * r) / (s.D * s.D);  // cos²θ − sin²α
         if (c.z < -r) s.kind = SphereClass::Behind;
         else if (c.z <= r || den < kMinDen) s.kind = SphereClass::Straddles;
@@ -100,9 +100,16 @@ double SphereProjection::index2(const PixelCoord& p) const {
 
 double SphereProjection::index(const PixelCoord& p) const { return std::sqrt(index2(p)); }
 
+double SphereProjection::alpha() const {
+    return kind == SphereClass::EyeInside ? std::numbers::pi / 2.0 : std::asin(std::clamp(sinAlpha, 0.0, 1.0));
+}
+
+double SphereProjection::theta() const { return D > 0.0 ? std::atan2(rho, c.z) : 0.0; }
+
 double SphereProjection::affineIndexError() const {
     if (kind != SphereClass::Ellipse) return std::numeric_limits<double>::infinity();
-    return std::tan(theta) * std::tan(alpha);
+    // tanθ·tanα with tanθ = ρ/z and tanα = r/√(D² − r²) (an Ellipse has z > r > 0 and D > r).
+    return (rho / c.z) * (r / std::sqrt((D - r) * (D + r)));
 }
 
 glm::dvec3 pixelRay(const SphereProjection& s, const PixelCoord& p) {

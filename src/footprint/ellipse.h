@@ -35,8 +35,8 @@ struct SphereProjection {
     double f = 0.0;            ///< focal length (pixels)
     PixelCoord principal{0.0}; ///< principal point (pixels)
     double D = 0.0;            ///< |c|
-    double alpha = 0.0;        ///< half cone angle asin(r/D); π/2 when the eye is inside
-    double theta = 0.0;        ///< angle between c and the optical axis, acos(c.z/D)
+    double sinAlpha = 0.0;     ///< sin α = r/D (DESIGN §2); 1 when the eye is inside
+    double rho = 0.0;          ///< D·sinθ = |c.xy|, the centre's distance from the optical axis
     glm::dvec2 u{1.0, 0.0};    ///< unit major direction in pixel space (radial; (1,0) on-axis)
     PixelCoord centre{0.0};    ///< ellipse centre (NOT the projection of c)
     double a = 0.0;            ///< semi-axis along u (pixels)
@@ -47,6 +47,11 @@ struct SphereProjection {
     glm::dmat2 toUnit{0.0};    ///< affine map p − centre ↦ unit-disk coordinates (columns: GLM)
 
     bool isEllipse() const { return kind == SphereClass::Ellipse; }
+    /// @brief Half cone angle α = asin(r/D); π/2 when the eye is inside. The hot path needs
+    /// only sin α (and sin²α): the angle is computed on demand, for the table path and tests.
+    double alpha() const;
+    /// @brief Angle θ between c and the optical axis, atan2(ρ, c.z) (on demand, as alpha()).
+    double theta() const;
     /// @brief i(p)²: squared affine index of pixel coordinate @p p, ≤ 1 inside the ellipse
     /// (DESIGN §3). +infinity for a sphere that is not an Ellipse.
     double index2(const PixelCoord& p) const;
@@ -55,6 +60,7 @@ struct SphereProjection {
     /// @brief tanθ·tanα: the measured max |d(i(p), α) − d_exact(p)| of the affine index over
     /// the ellipse, to within 15 % (docs/footprint.md; the footprint's error is ≈ 1.7× this,
     /// relative to its peak). 0 on the axis; +infinity for a sphere that is not an Ellipse.
+    /// Closed form from the geometry, no trigonometry: tanθ = ρ/c.z, tanα = r/√(D² − r²).
     double affineIndexError() const;
 };
 

@@ -33,7 +33,7 @@ ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVarianc
     k.b = std::sqrt(e.b * e.b + widen);
     k.conic = inFrame(e.u, 1.0 / (k.a * k.a), 1.0 / (k.b * k.b));
     k.amplitude = (e.a / k.a) * (e.b / k.b);  // √(det V / det V')
-    k.alpha = e.alpha;
+    k.sinAlpha = e.sinAlpha;
     k.pullback = inFrame(e.u, e.a / k.a, e.b / k.b);
     const glm::dvec2 v(-e.u.y, e.u.x);
     const glm::dvec2 half(std::sqrt(k.a * k.a * e.u.x * e.u.x + k.b * k.b * v.x * v.x),
@@ -44,7 +44,7 @@ ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVarianc
 
 SplatShader makeSplatShader(const ScreenKernel& k, const Tables& tables, double sigma, double h) {
     SplatShader s;
-    s.row = tables.reindex.row(k.alpha);
+    s.row = tables.reindex.row(k.alpha());
     s.footprint = &tables.footprint;
     s.scale = static_cast<float>(sigma * h * k.amplitude);
     return s;

@@ -12,6 +12,8 @@
 //     amplitude = √(det V / det V') = a·b / (a'·b')   (the deposit's total is unchanged,
 //     as in gsplat's antialiased mode).
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <glm/glm.hpp>
 
 #include "camera/camera.h"
@@ -30,7 +32,9 @@ struct ScreenKernel {
     double aGeom = 0.0, bGeom = 0.0;  ///< the exact ellipse's semi-axes before widening
     glm::dmat2 conic{0.0};     ///< Q: i² = (p − centre)ᵀ Q (p − centre), ≤ 1 on the support
     double amplitude = 0.0;    ///< √(det V / det(V + V_h)) ∈ (0, 1]
-    double alpha = 0.0;        ///< half cone angle of the sphere (for the reindex row)
+    double sinAlpha = 0.0;     ///< sin α of the sphere (sin²α picks the polynomial row)
+    /// @brief The half cone angle α (the table path's reindex row), asin on demand.
+    double alpha() const { return std::asin(std::clamp(sinAlpha, 0.0, 1.0)); }
     PixelBox bounds;           ///< exact bounding box of the support ellipse
     /// S: maps p − centre on the widened support to the geometric ellipse,
     /// S = R_u diag(a/a', b/b') R_uᵀ (used by the exact path).

@@ -60,8 +60,7 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
             p.centre = glm::vec2(kernel.centre);
             p.conic = glm::vec3(kernel.conic[0][0], kernel.conic[0][1], kernel.conic[1][1]);
             p.scale = float(sigma * kernel.amplitude);  // σ·h·amplitude with σ per world unit = sigma/h
-            p.alpha = float(kernel.alpha);
-            p.sin2Alpha = float((sphere.r / sphere.D) * (sphere.r / sphere.D));  // sin α = r/D
+            p.sin2Alpha = float(sphere.sinAlpha * sphere.sinAlpha);  // sin α = r/D
             if (p.kind == PrimitiveKind::SplatExactIndex) {
                 p.exactMap = makeExactIndexMap(kernel, sphere, PixelCoord(p.centre));  // δ from the float centre the loop uses
                 p.hasExactMap = true;
@@ -88,7 +87,7 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
 }
 
 std::span<const Primitive> projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx,
-                                        std::vector<Primitive>& prims) {
+                                        PrimitiveBuffer& prims) {
     if (prims.size() < batch.size()) prims.resize(batch.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {

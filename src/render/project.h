@@ -40,7 +40,7 @@ struct ProjectionContext {
 /// (grown when needed, never shrunk: the buffer is reused window after window).
 /// @return the primitives of this batch, prims[0 … batch.size()).
 std::span<const Primitive> projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx,
-                                        std::vector<Primitive>& prims);
+                                        PrimitiveBuffer& prims);
 
 /// @brief Projects one voxel (view-space centre @p c, extinction per voxel length @p sigma).
 /// @param spreadPx2 a level-of-detail aggregate's projected second moment (px², added to

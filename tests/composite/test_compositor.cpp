@@ -142,7 +142,7 @@ Image slowComposite(const std::vector<std::vector<Primitive>>& windows, int w, i
                         const float i2 = p.conic.x * dx * dx + 2.f * p.conic.y * dx * dy + p.conic.z * dy * dy;
                         if (!(i2 < 1.f)) continue;
                         SplatShader shader;
-                        shader.row = tables().reindex.row(p.alpha);
+                        shader.row = tables().reindex.row(halfConeAngle(p.sin2Alpha));
                         shader.footprint = &tables().footprint;
                         shader.scale = p.scale;
                         const float tau = p.kind == PrimitiveKind::SplatExactIndex
@@ -249,7 +249,7 @@ TEST(ProjectBatch, EqualsProjectVoxelOneByOne) {
         batch.members.push_back(1 + uint32_t(i % 5));
     }
     batch.slabBegin = 0, batch.slabEnd = 200;
-    std::vector<Primitive> buffer(7000);  // larger than the batch: only the first 5000 are this window
+    PrimitiveBuffer buffer(7000);  // larger than the batch: only the first 5000 are this window
     const std::span<const Primitive> prims = projectBatch(batch, ctx, buffer);
     ASSERT_EQ(prims.size(), batch.size());
     int kinds[6] = {};

@@ -23,7 +23,7 @@ ViewPoint direction(double thetaDeg, double phiDeg) {
 }
 
 bool allFinite(const SphereProjection& s) {
-    const double v[] = {s.D, s.alpha, s.theta, s.u.x, s.u.y, s.centre.x, s.centre.y, s.a, s.b,
+    const double v[] = {s.D, s.alpha(), s.theta(), s.u.x, s.u.y, s.centre.x, s.centre.y, s.a, s.b,
                         s.toUnit[0][0], s.toUnit[0][1], s.toUnit[1][0], s.toUnit[1][1]};
     for (double x : v)
         if (!std::isfinite(x)) return false;
@@ -114,8 +114,27 @@ TEST(Ellipse, OnAxisIsACircleAtThePrincipalPoint) {
     EXPECT_DOUBLE_EQ(s.centre.y, 150.0);
     EXPECT_NEAR(s.a, 400.0 * std::tan(std::asin(0.1)), 1e-9);
     EXPECT_NEAR(s.b, s.a, 1e-9);
-    EXPECT_DOUBLE_EQ(s.theta, 0.0);
-    EXPECT_NEAR(s.alpha, std::asin(0.1), 1e-15);
+    EXPECT_DOUBLE_EQ(s.theta(), 0.0);
+    EXPECT_NEAR(s.alpha(), std::asin(0.1), 1e-15);
+}
+
+// The projection takes no trigonometry (α and θ are computed on demand): its closed forms
+// agree with the angles' definitions, asin(r/D), acos(c.z/D) and tanθ·tanα.
+TEST(Ellipse, AnglesAndAffineIndexErrorWithoutTrigonometry) {
+    int ellipses = 0;
+    for (double thetaDeg = 0.0; thetaDeg < 80.0; thetaDeg += 3.7)
+        for (double phiDeg = 0.0; phiDeg < 360.0; phiDeg += 41.0)
+            for (const double D : {1.5, 4.0, 30.0, 900.0}) {
+                const ViewPoint c = D * direction(thetaDeg, phiDeg);
+                const SphereProjection s = projectSphere(c, 1.0, 500.0, {200.0, 200.0});
+                EXPECT_NEAR(s.alpha(), std::asin(1.0 / s.D), 1e-14);
+                EXPECT_NEAR(s.theta(), std::acos(c.z / s.D), 1e-7);  // acos loses half the digits near 0
+                if (!s.isEllipse()) continue;
+                ++ellipses;
+                const double trig = std::tan(std::acos(c.z / s.D)) * std::tan(std::asin(1.0 / s.D));
+                EXPECT_NEAR(s.affineIndexError(), trig, 1e-12 * (1.0 + trig)) << thetaDeg << " " << D;
+            }
+    EXPECT_GT(ellipses, 100);
 }
 
 TEST(Ellipse, CentreIsNotTheProjectionOfTheCentreAndYFlips) {
@@ -129,7 +148,7 @@ TEST(Ellipse, CentreIsNotTheProjectionOfTheCentreAndYFlips) {
     const double projected = 100.0 - f * c.y / c.z;
     EXPECT_LT(s.centre.y, projected - 1.0);  // pushed outward, away from the axis
     // The centre is the midpoint of the silhouette's extremes A', B' along u (Appendix A).
-    const double tA = std::tan(s.theta + s.alpha), tB = std::tan(s.theta - s.alpha);
+    const double tA = std::tan(s.theta() + s.alpha()), tB = std::tan(s.theta() - s.alpha());
     EXPECT_NEAR(s.centre.y, 100.0 - f * 0.5 * (tA + tB), 1e-9);
     EXPECT_NEAR(s.a, 0.5 * f * (tA - tB), 1e-9);
 }
@@ -139,7 +158,7 @@ TEST(Ellipse, EyeInsideIsExplicitAndFinite) {
         const SphereProjection s = projectSphere(c, 1.0, 200.0, {100.0, 100.0});  // D ≤ r (D = r included)
         EXPECT_EQ(s.kind, SphereClass::EyeInside) << c.x << " " << c.y << " " << c.z;
         EXPECT_TRUE(allFinite(s));
-        EXPECT_DOUBLE_EQ(s.alpha, std::numbers::pi / 2.0);
+        EXPECT_DOUBLE_EQ(s.alpha(), std::numbers::pi / 2.0);
         EXPECT_TRUE(std::isinf(s.index2({100.0, 100.0})));
         const PixelRange all = pixelRange(s.bounds, 200, 200);
         EXPECT_EQ(all.count(), 200 * 200);  // the fallback covers the whole image
@@ -228,7 +247,7 @@ TEST(Ellipse, AffineIndexErrorOffAxisIsMeasuredAndReported) {
                     const PixelCoord p(x + 0.5, y + 0.5);
                     const double i2 = s.index2(p);
                     if (i2 > 1.0) continue;
-                    const double dAffine = reindex(std::sqrt(i2), s.alpha);
+                    const double dAffine = reindex(std::sqrt(i2), s.alpha());
                     const double dExact = std::min(exactRayDistance(s, p), 1.0);
                     worstD = std::max(worstD, std::abs(dAffine - dExact));
                     worstF = std::max(worstF, std::abs(Kernel::footprint(dAffine * Kernel::kRadius) -

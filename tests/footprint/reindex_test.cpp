@@ -25,7 +25,7 @@ double maxOnAxisError(const std::function<double(double, double)>& formula, doub
         const double i = k / 400.0;
         const PixelCoord p = s.centre + i * s.a * glm::normalize(glm::dvec2(1.0, -2.0));
         EXPECT_NEAR(s.index(p), i, 1e-12);
-        worst = std::max(worst, std::abs(formula(s.index(p), s.alpha) - exactRayDistance(s, p)));
+        worst = std::max(worst, std::abs(formula(s.index(p), s.alpha()) - exactRayDistance(s, p)));
     }
     return worst;
 }

@@ -120,7 +120,7 @@ TEST(ScreenKernel, FastExactPathMatchesClosedFormExactPathOffAxis) {
     const double peak = Kernel::footprint(0.0) * k.amplitude;
     std::printf("off-axis splat (theta %.1f°, alpha %.1f°): max |table − exact| / peak = %.4f, "
                 "max |fast exact − exact| / peak = %.2e\n",
-                e.theta * 180.0 / std::numbers::pi, e.alpha * 180.0 / std::numbers::pi, worstTable / peak, worstFast / peak);
+                e.theta() * 180.0 / std::numbers::pi, e.alpha() * 180.0 / std::numbers::pi, worstTable / peak, worstFast / peak);
     EXPECT_LT(worstFast, 2e-4 * peak);
     EXPECT_GT(worstTable, 10.0 * worstFast);  // the affine index is the dominant error off-axis
 }
@@ -157,7 +157,7 @@ TEST(ScreenKernel, ExactIndexMapMatchesExactIndexD2) {
                 worst = std::max(worst, std::abs(std::sqrt(double(fast)) - std::sqrt(d2)));
             }
         std::printf("  theta %5.1f° alpha %5.2f°: %5d pixels, max |d_map − d_exact| = %.2e\n",
-                    e.theta * 180.0 / std::numbers::pi, e.alpha * 180.0 / std::numbers::pi, inside, worst);
+                    e.theta() * 180.0 / std::numbers::pi, e.alpha() * 180.0 / std::numbers::pi, inside, worst);
         EXPECT_GT(inside, 3);
         EXPECT_LT(worst, 2e-6);
     }
