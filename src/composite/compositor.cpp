@@ -3,7 +3,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
@@ -23,12 +22,47 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-/// Sort key: slab (relative to the window), then points before splats, then depth.
-uint64_t sortKey(const Primitive& p, int64_t slabBase) {
-    const uint64_t slab = uint64_t(std::clamp<int64_t>(p.slab - slabBase, 0, (int64_t(1) << 27) - 1));
-    const uint64_t kind = p.kind == PrimitiveKind::Point ? 0 : 1;
-    const uint64_t depth = std::bit_cast<uint32_t>(std::max(p.depth, 0.f));  // monotone for floats ≥ 0
-    return slab << 33 | kind << 32 | depth;
+/// The order of a window: slab, then points before splats, then depth (then the primitive's
+/// index, which the stable sort keeps). Packed into as few bits as the window's range needs:
+///     key = ((slab − slabBase) · 2 + kind) · 2^depthBits + (depth bits − depthBase)
+/// with the depth's float bits (monotone for floats ≥ 0), so the radix sort makes few passes.
+struct KeyLayout {
+    int64_t slabBase = 0;
+    uint32_t depthBase = 0;
+    int depthBits = 0;
+    int bits = 0;  ///< the key's width
+
+    static uint32_t depthOf(const Primitive& p) { return std::bit_cast<uint32_t>(std::max(p.depth, 0.f)); }
+    static uint64_t slabOf(const Primitive& p, int64_t base) {
+        return uint64_t(std::clamp<int64_t>(p.slab - base, 0, (int64_t(1) << 27) - 1));
+    }
+    uint64_t key(const Primitive& p) const {
+        const uint64_t kind = p.kind == PrimitiveKind::Point ? 0 : 1;
+        return ((slabOf(p, slabBase) << 1 | kind) << depthBits) | (depthOf(p) - depthBase);
+    }
+};
+
+/// Per chunk of a window: drawable primitives and the range of their slabs and depth bits.
+struct ChunkRange {
+    size_t count = 0;
+    int64_t slabLo = std::numeric_limits<int64_t>::max(), slabHi = std::numeric_limits<int64_t>::min();
+    uint32_t depthLo = std::numeric_limits<uint32_t>::max(), depthHi = 0;
+};
+
+/// Stable LSD radix sort of @p a by key, 8 bits a pass over the key's low @p bits; @p scratch
+/// has a.size() elements. Stable: entries with equal keys keep their (index) order.
+template <class Entry, class Buffer>
+void radixSort(Buffer& a, Buffer& scratch, int bits) {
+    const size_t n = a.size();
+    Entry *from = a.data(), *to = scratch.data();
+    for (int shift = 0; shift < bits; shift += 8) {
+        std::array<size_t, 257> start{};
+        for (size_t i = 0; i < n; ++i) ++start[((from[i].key >> shift) & 0xff) + 1];
+        for (size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+        for (size_t i = 0; i < n; ++i) to[start[(from[i].key >> shift) & 0xff]++] = from[i];
+        std::swap(from, to);
+    }
+    if (from != a.data()) std::copy(from, from + n, a.data());
 }
 }  // namespace
 
@@ -84,31 +118,52 @@ SkippedPrimitives TileCompositor::composite(std::span<const Primitive> prims, do
 
 /// One global sort by (key, index), then a gather: every tile's list comes out in order
 /// without a per-tile sort, and the tiles read their primitives sequentially (indexing the
-/// window in key order was a cache miss per primitive at far views). Every pass is parallel
-/// over fixed chunks of the window, so the result does not depend on the thread count; what
-/// is gathered is the 64-byte TileRecord, not the Primitive.
+/// window in key order was a cache miss per primitive at far views). The key passes and the
+/// gather are parallel over fixed chunks of the window; the sort is a serial radix sort of
+/// the packed keys (KeyLayout: typically 20–30 bits, 3–4 passes, several times faster than a
+/// comparison sort of the 16-byte entries). Nothing depends on the thread count; what is
+/// gathered is the 64-byte TileRecord, not the Primitive.
 void TileCompositor::sortWindow(std::span<const Primitive> prims) {
     const size_t n = prims.size();
     const size_t chunks = std::clamp<size_t>(n / 16384, 1, 64), per = (n + chunks - 1) / chunks;
     const auto drawable = [](const Primitive& p) { return p.kind != PrimitiveKind::Culled && !p.range.empty(); };
-    // Per chunk: drawable primitives and their lowest slab (the key's slab is relative to it).
-    std::vector<size_t>& count = chunkCounts_;
-    count.assign(chunks + 1, 0);
-    std::vector<int64_t> lowest(chunks, std::numeric_limits<int64_t>::max());
+    // Per chunk: drawable primitives and the range of their keys.
+    std::vector<ChunkRange> range(chunks);
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-        for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i)
-            if (drawable(prims[i])) ++count[c], lowest[c] = std::min(lowest[c], prims[i].slab);
+        ChunkRange& r = range[c];
+        for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) {
+            const Primitive& p = prims[i];
+            if (!drawable(p)) continue;
+            ++r.count;
+            r.slabLo = std::min(r.slabLo, p.slab), r.slabHi = std::max(r.slabHi, p.slab);
+            r.depthLo = std::min(r.depthLo, KeyLayout::depthOf(p)), r.depthHi = std::max(r.depthHi, KeyLayout::depthOf(p));
+        }
     });
-    const int64_t slabBase = *std::min_element(lowest.begin(), lowest.end());
-    size_t total = 0;
-    for (size_t c = 0; c <= chunks; ++c) total += std::exchange(count[c], total);  // count[c]: chunk c's cursor
+    ChunkRange all;
+    std::vector<size_t>& cursor = chunkCounts_;
+    cursor.assign(chunks, 0);
+    for (size_t c = 0; c < chunks; ++c) {
+        cursor[c] = all.count, all.count += range[c].count;
+        all.slabLo = std::min(all.slabLo, range[c].slabLo), all.slabHi = std::max(all.slabHi, range[c].slabHi);
+        all.depthLo = std::min(all.depthLo, range[c].depthLo), all.depthHi = std::max(all.depthHi, range[c].depthHi);
+    }
+    const size_t total = all.count;
+    KeyLayout layout;
+    if (total > 0) {
+        layout.slabBase = all.slabLo, layout.depthBase = all.depthLo;
+        layout.depthBits = int(std::bit_width(all.depthHi - all.depthLo));
+        const uint64_t slabSpan = uint64_t(std::min<int64_t>(all.slabHi - all.slabLo, (int64_t(1) << 27) - 1));
+        layout.bits = int(std::bit_width(slabSpan)) + 1 + layout.depthBits;
+    }
     order_.resize(total);
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-        size_t cursor = count[c];
+        size_t k = cursor[c];
         for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i)
-            if (drawable(prims[i])) order_[cursor++] = {sortKey(prims[i], slabBase), uint32_t(i)};
+            if (drawable(prims[i])) order_[k++] = {layout.key(prims[i]), uint32_t(i)};
     });
-    tbb::parallel_sort(order_.begin(), order_.end());  // a total order: the result is unique
+    // order_ is in index order; the stable sort by key makes it the total (key, index) order.
+    if (sortScratch_.size() < total) sortScratch_.resize(total);
+    radixSort<Entry>(order_, sortScratch_, layout.bits);
     if (records_.size() < total) records_.resize(total), maps_.resize(total);  // grow only: no per-window construction
     tbb::parallel_for(tbb::blocked_range<size_t>(0, total, 4096), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t k = r.begin(); k < r.end(); ++k) {
@@ -119,7 +174,7 @@ void TileCompositor::sortWindow(std::span<const Primitive> prims) {
             q.scale = p.scale, q.sin2Alpha = p.sin2Alpha;
             q.color = p.color;
             q.range = p.range;
-            q.slab = uint32_t(std::clamp<int64_t>(p.slab - slabBase, 0, std::numeric_limits<uint32_t>::max()));
+            q.slab = uint32_t(std::clamp<int64_t>(p.slab - layout.slabBase, 0, std::numeric_limits<uint32_t>::max()));
             q.kind = p.kind;
             q.hasExactMap = p.hasExactMap;
             if (p.hasExactMap) maps_[k] = p.exactMap;
@@ -242,9 +297,15 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
             }
         slab.dirty = false;
     };
-    constexpr size_t kAhead = 8;  // records are a cache miss each (a tile's list is sparse in records_)
+    // Records are a cache miss each (a tile's list is sparse in records_): fetch them 8 ahead,
+    // and an exact-index splat's map (two lines) 4 ahead, once its record has arrived.
+    constexpr size_t kAhead = 8, kMapAhead = 4;
     for (size_t e = 0; e < entries.size(); ++e) {
         if (e + kAhead < entries.size()) __builtin_prefetch(&records_[entries[e + kAhead]]);
+        if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) {
+            const char* map = reinterpret_cast<const char*>(&maps_[entries[e + kMapAhead]]);
+            __builtin_prefetch(map), __builtin_prefetch(map + sizeof(ExactIndexMap) - 1);
+        }
         const uint32_t k = entries[e];
         const TileRecord& p = records_[k];
         const bool isPoint = p.kind == PrimitiveKind::Point;

@@ -103,7 +103,8 @@ private:
     Buffer<float> transmittance_;
     std::vector<int> liveCount_;          // per tile: pixels with T ≥ ε
     std::span<const Primitive> window_;   // the window being composited (composite()'s argument)
-    Buffer<Entry> order_;            // the window's drawable primitives in (key, index) order
+    Buffer<Entry> order_;
+    Buffer<Entry> sortScratch_;           // the radix sort's second buffer            // the window's drawable primitives in (key, index) order
     Buffer<TileRecord> records_;     // ... gathered in that order (the first order_.size())
     Buffer<ExactIndexMap> maps_;     // ... their exact-index maps, where hasExactMap
     std::vector<size_t> chunkCounts_;     // sortWindow's per-chunk counts and cursors

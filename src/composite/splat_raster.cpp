@@ -78,6 +78,7 @@ void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) {
             // τ = scale·√(1 − t)·G(2t − 1), Horner (footprint_poly.h)
             const V x = hn::MulSub(two, t, one);
             V p = hn::Set(d, s.coef[FootprintPolynomials::kDegree]);
+#pragma GCC unroll 16
             for (int j = FootprintPolynomials::kDegree - 1; j >= 0; --j) p = hn::MulAdd(p, x, hn::Set(d, s.coef[size_t(j)]));
             const V tau = hn::Max(hn::Mul(hn::Mul(scale, hn::Sqrt(hn::Sub(one, t))), p), zero);
             const V alpha = hn::Neg(hn::Expm1(d, hn::Neg(tau)));  // 1 − e^{−τ}

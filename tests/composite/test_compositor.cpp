@@ -215,6 +215,30 @@ TEST(TileCompositor, MatchesTheSlowPerPixelCompositor) {
     }
 }
 
+// The packed radix-sort key (compositor.cpp, KeyLayout) against the slow compositor's
+// comparison sort where it is hardest: many equal keys (the index must break the tie, as
+// the stable sort does), slabs spread over a million, depths from 0 (the eye) to 10⁶.
+TEST(TileCompositor, OrderWithTiesAndWideKeyRanges) {
+    const Camera camera = testCamera(72);
+    auto windows = randomWindows(camera, RenderMode::Hybrid);
+    std::mt19937 rng(17);
+    std::uniform_int_distribution<int> pick(0, 5);
+    for (auto& w : windows)
+        for (size_t i = 0; i < w.size(); ++i) {
+            Primitive& p = w[i];
+            switch (pick(rng)) {
+                case 0: p.depth = 25.f, p.slab = 250; break;  // ties: same slab, kind and depth
+                case 1: p.depth = 0.f; break;
+                case 2: p.depth = 1.0e6f, p.slab = 1000000; break;
+                default: break;
+            }
+        }
+    const Image slow = slowComposite(windows, camera.width(), camera.height());
+    const Image scalar = fastComposite(windows, camera, false);
+    std::printf("  scalar vs slow: %.2g\n", maxDifference(scalar, slow));
+    EXPECT_LT(maxDifference(scalar, slow), 1e-5);
+}
+
 // The compositor's image is the same, bit for bit, whatever the thread count.
 TEST(TileCompositor, SameImageForAnyThreadCount) {
     const Camera camera = testCamera(72);
