@@ -49,20 +49,32 @@ struct ChunkRange {
     uint32_t depthLo = std::numeric_limits<uint32_t>::max(), depthHi = 0;
 };
 
-/// Stable LSD radix sort of @p a by key, 8 bits a pass over the key's low @p bits; @p scratch
-/// has a.size() elements. Stable: entries with equal keys keep their (index) order.
-template <class Entry, class Buffer>
-void radixSort(Buffer& a, Buffer& scratch, int bits) {
-    const size_t n = a.size();
-    Entry *from = a.data(), *to = scratch.data();
+/// Stable LSD radix sort of the @p n entries at @p a by key, 8 bits a pass over the key's
+/// low @p bits, ping-ponging with @p scratch (n entries); returns where the result is (a or
+/// scratch). Each pass is parallel over fixed chunks: per-chunk digit counts, offsets digit by
+/// digit then chunk by chunk, scatter. Stable, so entries with equal keys keep their (index)
+/// order, and the chunks are fixed by n, so the result does not depend on the thread count.
+template <class Entry>
+Entry* radixSort(Entry* a, Entry* scratch, size_t n, int bits) {
+    const size_t chunks = std::clamp<size_t>(n / 16384, 1, 64), per = (n + chunks - 1) / chunks;
+    std::vector<std::array<size_t, 256>> start(chunks);
+    Entry *from = a, *to = scratch;
     for (int shift = 0; shift < bits; shift += 8) {
-        std::array<size_t, 257> start{};
-        for (size_t i = 0; i < n; ++i) ++start[((from[i].key >> shift) & 0xff) + 1];
-        for (size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
-        for (size_t i = 0; i < n; ++i) to[start[(from[i].key >> shift) & 0xff]++] = from[i];
+        tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+            std::array<size_t, 256>& count = start[c];
+            count.fill(0);
+            for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) ++count[(from[i].key >> shift) & 0xff];
+        });
+        size_t total = 0;
+        for (size_t digit = 0; digit < 256; ++digit)
+            for (size_t c = 0; c < chunks; ++c) total += std::exchange(start[c][digit], total);
+        tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+            std::array<size_t, 256>& cursor = start[c];
+            for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) to[cursor[(from[i].key >> shift) & 0xff]++] = from[i];
+        });
         std::swap(from, to);
     }
-    if (from != a.data()) std::copy(from, from + n, a.data());
+    return from;
 }
 }  // namespace
 
@@ -155,16 +167,17 @@ void TileCompositor::sortWindow(std::span<const Primitive> prims) {
         const uint64_t slabSpan = uint64_t(std::min<int64_t>(all.slabHi - all.slabLo, (int64_t(1) << 27) - 1));
         layout.bits = int(std::bit_width(slabSpan)) + 1 + layout.depthBits;
     }
-    order_.resize(total);
+    // Buffers grow only (default-initialised: nothing is written until the parallel passes).
+    growDiscarding(order_, total), growDiscarding(sortScratch_, total);
+    growDiscarding(records_, total), growDiscarding(maps_, total);
+    orderCount_ = total;
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         size_t k = cursor[c];
         for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i)
             if (drawable(prims[i])) order_[k++] = {layout.key(prims[i]), uint32_t(i)};
     });
     // order_ is in index order; the stable sort by key makes it the total (key, index) order.
-    if (sortScratch_.size() < total) sortScratch_.resize(total);
-    radixSort<Entry>(order_, sortScratch_, layout.bits);
-    if (records_.size() < total) records_.resize(total), maps_.resize(total);  // grow only: no per-window construction
+    if (radixSort(order_.data(), sortScratch_.data(), total, layout.bits) != order_.data()) std::swap(order_, sortScratch_);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, total, 4096), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t k = r.begin(); k < r.end(); ++k) {
             const Primitive& p = prims[order_[k].index];
@@ -186,7 +199,7 @@ void TileCompositor::sortWindow(std::span<const Primitive> prims) {
 /// sorted position, skipping tiles that are already opaque. Parallel over fixed chunks of
 /// records_: count per (chunk, tile), prefix sums, fill; the lists do not depend on the chunking.
 SkippedPrimitives TileCompositor::binToTiles() {
-    const size_t tiles = size_t(tilesX_) * tilesY_, n = order_.size();
+    const size_t tiles = size_t(tilesX_) * tilesY_, n = orderCount_;
     const size_t chunks = std::clamp<size_t>(n / 16384, 1, 16), per = (n + chunks - 1) / chunks;
     std::vector<uint32_t>& counts = binCounts_;  // reused: fresh pages cost a fault each on every window
     counts.assign(chunks * tiles, 0);
@@ -225,7 +238,7 @@ SkippedPrimitives TileCompositor::binToTiles() {
         }
     }
     binStart_[tiles] = total;
-    binEntries_.resize(total);
+    growDiscarding(binEntries_, total);
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         uint32_t* cursor = counts.data() + c * tiles;
         for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k)

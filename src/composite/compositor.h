@@ -103,10 +103,11 @@ private:
     Buffer<float> transmittance_;
     std::vector<int> liveCount_;          // per tile: pixels with T ≥ ε
     std::span<const Primitive> window_;   // the window being composited (composite()'s argument)
-    Buffer<Entry> order_;
-    Buffer<Entry> sortScratch_;           // the radix sort's second buffer            // the window's drawable primitives in (key, index) order
-    Buffer<TileRecord> records_;     // ... gathered in that order (the first order_.size())
-    Buffer<ExactIndexMap> maps_;     // ... their exact-index maps, where hasExactMap
+    size_t orderCount_ = 0;               // the window's drawable primitives (the buffers grow only)
+    Buffer<Entry> order_;                 // the window's drawable primitives in (key, index) order
+    Buffer<Entry> sortScratch_;           // the radix sort's second buffer
+    Buffer<TileRecord> records_;          // ... gathered in that order
+    Buffer<ExactIndexMap> maps_;          // ... their exact-index maps, where hasExactMap
     std::vector<size_t> chunkCounts_;     // sortWindow's per-chunk counts and cursors
     std::vector<size_t> binStart_;        // per tile (+1): its list in binEntries_
     Buffer<uint32_t> binEntries_;    // per tile: positions in records_, ascending

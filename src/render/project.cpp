@@ -88,7 +88,7 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
 
 std::span<const Primitive> projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx,
                                         PrimitiveBuffer& prims) {
-    if (prims.size() < batch.size()) prims.resize(batch.size());
+    growDiscarding(prims, batch.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
             Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);

@@ -37,7 +37,7 @@ struct ProjectionContext {
 };
 
 /// @brief Projects every voxel of @p batch into the first batch.size() elements of @p prims
-/// (grown when needed, never shrunk: the buffer is reused window after window).
+/// (grown when needed, with headroom, never shrunk: the buffer is reused window after window).
 /// @return the primitives of this batch, prims[0 … batch.size()).
 std::span<const Primitive> projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx,
                                         PrimitiveBuffer& prims);

@@ -14,6 +14,8 @@
 
 #include <cstddef>
 #include <new>
+#include <type_traits>
+#include <utility>
 
 namespace vdbsplat {
 
@@ -39,7 +41,8 @@ inline void* map(std::size_t bytes) {
 }
 }  // namespace huge_pages
 
-/// @brief std::allocator's interface; blocks of at least 2 MiB come from huge_pages::map.
+/// @brief std::allocator's interface; blocks of at least 2 MiB come from huge_pages::map, and
+/// elements are default-initialised, not value-initialised (see construct()).
 template <class T>
 struct HugePageAllocator {
     using value_type = T;
@@ -58,8 +61,28 @@ struct HugePageAllocator {
         if (bytes < huge_pages::kHugePage) ::operator delete(p, std::align_val_t(alignof(T) > 16 ? alignof(T) : 16));
         else munmap(p, huge_pages::roundUp(bytes));
     }
+    /// Default-initialises (trivial types: leaves them as they are): the renderer's buffers are
+    /// written before they are read, and vector::resize would otherwise zero them, serially.
+    template <class U>
+    void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
     template <class U>
     bool operator==(const HugePageAllocator<U>&) const noexcept { return true; }
 };
+
+/// @brief Grows @p buffer to at least @p n elements without keeping its contents (a window's
+/// buffers are rewritten whole): no copy on growth, and 50 % headroom so that slowly growing
+/// windows do not reallocate every time. Never shrinks.
+template <class Buffer>
+void growDiscarding(Buffer& buffer, std::size_t n) {
+    if (buffer.size() >= n) return;
+    Buffer().swap(buffer);
+    buffer.resize(n + n / 2);
+}
 
 }  // namespace vdbsplat
