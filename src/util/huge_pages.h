@@ -76,13 +76,14 @@ struct HugePageAllocator {
 };
 
 /// @brief Grows @p buffer to at least @p n elements without keeping its contents (a window's
-/// buffers are rewritten whole): no copy on growth, and 50 % headroom so that slowly growing
-/// windows do not reallocate every time. Never shrinks.
+/// buffers are rewritten whole): no copy on growth, and 1/8 of headroom so that slowly growing
+/// windows do not reallocate every time (little: the window's buffers are the renderer's
+/// largest, DESIGN §5 bounds them by the window). Never shrinks.
 template <class Buffer>
 void growDiscarding(Buffer& buffer, std::size_t n) {
     if (buffer.size() >= n) return;
     Buffer().swap(buffer);
-    buffer.resize(n + n / 2);
+    buffer.resize(n + n / 8);
 }
 
 }  // namespace vdbsplat
