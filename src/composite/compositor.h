@@ -1,7 +1,8 @@
 // composite/compositor.h — the one EWA-filtered, front-to-back compositor (DESIGN §4, §5).
-// Owns: the frame (premultiplied colour and transmittance per pixel), binning a
-// window's primitives to 16×16 screen tiles with a (slab, kind, depth, index)
-// key, and compositing every tile's list independently and in parallel:
+// Owns: the frame (premultiplied colour and transmittance per pixel), ordering a
+// window's primitives by a (slab, kind, depth, index) key (a stable radix sort of
+// packed keys) and gathering them as 64-byte tile records, binning those to 16×16
+// screen tiles, and compositing every tile's list independently and in parallel:
 //   - points of one slab are summed into a slab buffer (optical depth and
 //     σ-weighted colour) and composited when the slab ends, so side-by-side
 //     points never occlude each other;
