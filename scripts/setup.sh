@@ -3,7 +3,7 @@
 # Idempotent; needs root (or sudo) only when something is missing.
 set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config git
-      libopenvdb-dev libboost-iostreams-dev libopenimageio-dev libglm-dev libtbb-dev
+      libopenvdb-dev libboost-iostreams-dev libopenexr-dev libglm-dev libtbb-dev
       libgtest-dev libbenchmark-dev nlohmann-json3-dev zlib1g-dev libhwy-dev
       libpng-dev libpugixml-dev clang)  # clang: the sanitizer and libFuzzer build (scripts/sanitize.sh, scripts/fuzz.sh)
 missing=()

@@ -1,17 +1,26 @@
-// image/image.cpp — PNG/EXR output through OpenImageIO, atomic via rename (through a
-// symbolic link to its target; never over a device node), and the bounded, checked input
-// of `compare` (a PNG or EXR by content, one flat 2D image, bounded in size, checked
-// before any pixel is read).
+// image/image.cpp — PNG output through libpng's simplified API and EXR output through
+// OpenEXR, atomic via rename (through a symbolic link to its target; never over a device
+// node), and the bounded, checked input of `compare` (a PNG or EXR by content, one flat 2D
+// image, bounded in size, checked before any pixel is read). The two libraries are used
+// directly, not through OpenImageIO: its 230 shared libraries (codecs, OpenCV, GDAL, ...) cost
+// every vdbsplat process about 0.5 s of CPU and 100 MB before main() (docs/performance.md).
 #include "image/image.h"
 
-#include <OpenImageIO/imageio.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfPartType.h>
+#include <ImfStringAttribute.h>
 #include <png.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
-#include <memory>
 #include <unistd.h>
 
 #include "util/atomic_file.h"
@@ -26,124 +35,188 @@ std::string extensionOf(const std::string& path) {
     return ext;
 }
 
-/// OpenImageIO's messages name the temporary file; the user's path replaces it.
+/// A library's message on one line, naming the user's @p path where it names @p tmp.
 std::string renamed(std::string message, const std::string& tmp, const std::string& path) {
-    for (size_t at = message.find(tmp); at != std::string::npos; at = message.find(tmp, at + path.size()))
+    for (size_t at = message.find(tmp); !tmp.empty() && at != std::string::npos; at = message.find(tmp, at + path.size()))
         message.replace(at, tmp.size(), path);
     for (char& c : message)
         if (c == '\n' || c == '\r') c = ' ';
     return message;
 }
 
-/// Writes @p data to the file @p tmp; errors name @p path (the user's output), not @p tmp.
-void writeWith(const std::string& tmp, const std::string& path, const std::string& format,
-               const OIIO::ImageSpec& spec, const void* data) {
-    auto out = OIIO::ImageOutput::create(format);
-    if (!out) throw Error(path + ": cannot create a " + format + " writer: " + renamed(OIIO::geterror(), tmp, path));
-    if (!out->open(tmp, spec)) throw Error(path + ": cannot open for writing: " + renamed(out->geterror(), tmp, path));
-    const bool ok = out->write_image(spec.format, data);
-    const bool closed = out->close();
-    if (!ok || !closed) throw Error(path + ": write failed: " + renamed(out->geterror(), tmp, path));
-}
+std::string oneLineText(std::string s) { return renamed(std::move(s), "", ""); }
 
-std::string oneLineText(std::string s);
+std::string sizeText(int64_t w, int64_t h) { return std::to_string(w) + "x" + std::to_string(h); }
 
-/// Refuses what `compare` cannot treat as one flat image, before any pixel is read.
-void checkInputSpec(OIIO::ImageInput& in, const OIIO::ImageSpec& spec, const std::string& path) {
-    if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1) throw Error(path + ": empty image");
-    if (spec.depth > 1)
-        throw Error(path + ": is a volume image (" + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                    "x" + std::to_string(spec.depth) + "), not a 2D PNG or EXR");
-    if (spec.deep) throw Error(path + ": is a deep image; only flat PNG or EXR images can be compared");
-    if (spec.width > kMaxImageSide || spec.height > kMaxImageSide)
-        throw Error(path + ": image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                    ", larger than the " + std::to_string(kMaxImageSide) + " pixels per side vdbsplat reads");
-    if (uint64_t(spec.width) * uint64_t(spec.height) > kMaxImagePixels)
-        throw Error(path + ": image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                    ", more than the " + std::to_string(kMaxImagePixels) + " pixels (8192x8192) vdbsplat reads");
-    if (spec.nchannels > 64) throw Error(path + ": image has " + std::to_string(spec.nchannels) + " channels");
-    if (in.seek_subimage(1, 0)) throw Error(path + ": holds several images (subimages); expected one");
-    (void)in.geterror();  // the failed seek's message
-    if (!in.seek_subimage(0, 0)) throw Error(path + ": cannot read image: " + oneLineText(in.geterror()));
-}
-
-/// OpenImageIO's message on one line.
-std::string oneLineText(std::string s) {
-    for (char& c : s)
-        if (c == '\n' || c == '\r') c = ' ';
-    return s;
-}
-
-/// The OpenImageIO reader for @p path chosen by its first bytes: "png", "openexr", or ""
-/// for anything else. compare reads PNG and EXR only: left to itself OpenImageIO tries every
-/// plugin it has (its OpenVDB plugin read a damaged .vdb named .png in-process).
-std::string readerByContent(const std::string& path) {
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) return "";
-    unsigned char sig[8] = {};
-    const size_t n = std::fread(sig, 1, sizeof sig, f);
-    std::fclose(f);
-    if (n == sizeof sig && png_sig_cmp(sig, 0, sizeof sig) == 0) return "png";
-    if (n >= 4 && sig[0] == 0x76 && sig[1] == 0x2f && sig[2] == 0x31 && sig[3] == 0x01) return "openexr";
-    return "";
-}
-
-/// True when @p path starts with OpenVDB's magic number (int64 0x56444220, little-endian).
-bool isVdbFile(const std::string& path) {
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) return false;
-    unsigned char sig[8] = {};
-    const size_t n = std::fread(sig, 1, sizeof sig, f);
-    std::fclose(f);
-    static const unsigned char kMagic[8] = {0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0};
-    return n == sizeof sig && std::equal(sig, sig + 8, kMagic);
-}
-
-/// Decodes a PNG once through libpng's simplified API, which reports errors and warnings
-/// in png_image::message instead of printing them: OpenImageIO's PNG reader lets libpng's
-/// default handler print "libpng error: …" on stderr before it returns its own error, so a
-/// damaged PNG must be caught here, quietly. Checks the size limits from the header first.
-void validatePng(const std::string& path) {
-    png_image image{};
-    image.version = PNG_IMAGE_VERSION;
-    const auto failed = [&](const std::string& what) {
-        const std::string message = image.message[0] ? std::string(image.message) : "unknown libpng error";
-        png_image_free(&image);
-        return Error(path + ": " + what + ": " + oneLineText(message));
-    };
-    if (!png_image_begin_read_from_file(&image, path.c_str())) throw failed("cannot read PNG");
-    const uint32_t w = image.width, h = image.height;
-    if (w > uint32_t(kMaxImageSide) || h > uint32_t(kMaxImageSide) || uint64_t(w) * h > kMaxImagePixels) {
-        png_image_free(&image);
-        throw Error(path + ": image is " + std::to_string(w) + "x" + std::to_string(h) + ", more than the " +
-                    std::to_string(kMaxImageSide) + " pixels per side or " + std::to_string(kMaxImagePixels) +
+/// Refuses a @p w x @p h image beyond the limits of image.h, before any pixel is read.
+void checkImageSize(int64_t w, int64_t h, const std::string& path) {
+    if (w < 1 || h < 1) throw Error(path + ": empty image (" + sizeText(w, h) + ")");
+    if (w > kMaxImageSide || h > kMaxImageSide)
+        throw Error(path + ": image is " + sizeText(w, h) + ", larger than the " + std::to_string(kMaxImageSide) +
+                    " pixels per side vdbsplat reads");
+    if (uint64_t(w) * uint64_t(h) > kMaxImagePixels)
+        throw Error(path + ": image is " + sizeText(w, h) + ", more than the " + std::to_string(kMaxImagePixels) +
                     " pixels (8192x8192) vdbsplat reads");
-    }
-    image.format = PNG_FORMAT_RGBA;
-    std::vector<png_byte> pixels(PNG_IMAGE_SIZE(image));
-    if (!png_image_finish_read(&image, nullptr, pixels.data(), 0, nullptr)) throw failed("cannot decode PNG");
-    png_image_free(&image);
 }
 
-/// Keeps the codecs under OpenImageIO from printing on their own: their messages must reach
-/// vdbsplat (through geterror() or validatePng) and become the one error line.
-void quietImageLibraries(const std::string& path) {
-    if (readerByContent(path) == "png") validatePng(path);
+/// The first 8 bytes of @p path (fewer if it is shorter; none if it cannot be opened).
+std::vector<unsigned char> signatureOf(const std::string& path) {
+    std::vector<unsigned char> sig(8);
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return {};
+    sig.resize(std::fread(sig.data(), 1, sig.size(), f));
+    std::fclose(f);
+    return sig;
 }
 
-/// Opens @p path with the PNG or EXR reader its content calls for; anything else is refused.
-std::unique_ptr<OIIO::ImageInput> openPngOrExr(const std::string& path) {
-    const std::string reader = readerByContent(path);
-    if (reader.empty()) {
-        if (isVdbFile(path)) throw Error(path + ": is a VDB file (a volume image), not a 2D PNG or EXR");
-        throw Error(path + ": not a PNG or EXR image (unrecognised content)");
+bool isPng(const std::vector<unsigned char>& sig) {
+    return sig.size() == 8 && png_sig_cmp(sig.data(), 0, 8) == 0;
+}
+bool isExr(const std::vector<unsigned char>& sig) {
+    return sig.size() >= 4 && sig[0] == 0x76 && sig[1] == 0x2f && sig[2] == 0x31 && sig[3] == 0x01;
+}
+/// OpenVDB's magic number (int64 0x56444220, little-endian).
+bool isVdb(const std::vector<unsigned char>& sig) {
+    static const unsigned char kMagic[8] = {0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0};
+    return sig.size() == 8 && std::equal(sig.begin(), sig.end(), kMagic);
+}
+
+/// libpng's simplified API reports errors and warnings in png_image::message and never
+/// prints them; this frees the image on every path.
+struct PngImage {
+    png_image image{};
+    PngImage() { image.version = PNG_IMAGE_VERSION; }
+    ~PngImage() { png_image_free(&image); }
+    std::string message() const { return image.message[0] ? oneLineText(image.message) : "unknown libpng error"; }
+};
+
+void writePng(const std::string& tmp, const std::string& path, const Image& image) {
+    std::vector<png_byte> bytes(size_t(image.width) * image.height * 3);
+    for (size_t i = 0; i < image.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            bytes[3 * i + c] = static_cast<png_byte>(std::lround(255.0f * linearToSrgb(image.pixels[i][c])));
+    PngImage png;
+    png.image.width = png_uint_32(image.width);
+    png.image.height = png_uint_32(image.height);
+    png.image.format = PNG_FORMAT_RGB;
+    if (!png_image_write_to_file(&png.image, tmp.c_str(), 0, bytes.data(), 0, nullptr))
+        throw Error(path + ": write failed: " + renamed(png.message(), tmp, path));
+}
+
+/// Sets OpenEXR's own header limits (it checks them while reading a header, before it
+/// allocates line or tile tables from it) to the bounds of checkImageSize. They are
+/// process-wide settings of the library, so they are set again before every read.
+void limitOpenExr() {
+    Imf::Header::setMaxImageSize(kMaxImageSide, kMaxImageSide);
+    Imf::Header::setMaxTileSize(kMaxImageSide, kMaxImageSide);
+}
+
+void writeExr(const std::string& tmp, const std::string& path, const Image& image,
+              const std::map<std::string, std::string>& metadata) {
+    try {
+        Imf::Header header(image.width, image.height);
+        header.compression() = Imf::ZIP_COMPRESSION;
+        for (const auto& [key, value] : metadata) header.insert("vdbsplat:" + key, Imf::StringAttribute(value));
+        Imf::FrameBuffer frame;
+        const char* base = reinterpret_cast<const char*>(image.pixels.data());
+        const size_t xStride = sizeof(glm::vec4), yStride = xStride * size_t(image.width);
+        const char* names[4] = {"R", "G", "B", "A"};
+        for (int c = 0; c < 4; ++c) {
+            header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+            frame.insert(names[c], Imf::Slice(Imf::FLOAT, const_cast<char*>(base) + c * sizeof(float), xStride, yStride));
+        }
+        Imf::OutputFile file(tmp.c_str(), header);
+        file.setFrameBuffer(frame);
+        file.writePixels(image.height);
+    } catch (const std::exception& e) {
+        throw Error(path + ": write failed: " + renamed(e.what(), tmp, path));
     }
-    quietImageLibraries(path);
-    auto in = OIIO::ImageInput::create(reader);
-    OIIO::ImageSpec spec;
-    if (!in || !in->open(path, spec))
-        throw Error(path + ": cannot read image: " + oneLineText(in ? in->geterror() : OIIO::geterror()));
-    return in;
+}
+
+/// A PNG, decoded to linear premultiplied RGBA: 8-bit files through vdbsplat's own sRGB curve
+/// (so a PNG that vdbsplat wrote reads back to the values it encoded), 16-bit files through
+/// libpng's linear 16-bit form (premultiplied by libpng).
+Image readPng(const std::string& path) {
+    PngImage png;
+    if (!png_image_begin_read_from_file(&png.image, path.c_str()))
+        throw Error(path + ": cannot read PNG: " + png.message());
+    checkImageSize(png.image.width, png.image.height, path);
+    Image image(static_cast<int>(png.image.width), static_cast<int>(png.image.height));
+    if (png.image.format & PNG_FORMAT_FLAG_LINEAR) {
+        png.image.format = PNG_FORMAT_LINEAR_RGB_ALPHA;
+        std::vector<png_uint_16> data(PNG_IMAGE_SIZE(png.image) / sizeof(png_uint_16));
+        if (!png_image_finish_read(&png.image, nullptr, data.data(), 0, nullptr))
+            throw Error(path + ": cannot decode PNG: " + png.message());
+        for (size_t i = 0; i < image.pixels.size(); ++i)
+            image.pixels[i] = glm::vec4(data[4 * i], data[4 * i + 1], data[4 * i + 2], data[4 * i + 3]) / 65535.0f;
+    } else {
+        png.image.format = PNG_FORMAT_RGBA;
+        std::vector<png_byte> data(PNG_IMAGE_SIZE(png.image));
+        if (!png_image_finish_read(&png.image, nullptr, data.data(), 0, nullptr))
+            throw Error(path + ": cannot decode PNG: " + png.message());
+        for (size_t i = 0; i < image.pixels.size(); ++i) {
+            const float alpha = data[4 * i + 3] / 255.0f;
+            glm::vec4 p(0.0f, 0.0f, 0.0f, alpha);
+            for (int c = 0; c < 3; ++c) p[c] = srgbToLinear(data[4 * i + c] / 255.0f) * alpha;
+            image.pixels[i] = p;
+        }
+    }
+    return image;
+}
+
+/// The channels an EXR image is read from: R, G, B (and A) if it has them, else Y (and A),
+/// else its only channel; one channel is grey. Refuses anything else, naming the channels.
+std::vector<std::string> exrChannels(const Imf::ChannelList& channels, const std::string& path) {
+    const auto has = [&](const char* name) { return channels.findChannel(name) != nullptr; };
+    std::vector<std::string> names;
+    if (has("R") && has("G") && has("B")) names = {"R", "G", "B"};
+    else if (has("Y")) names = {"Y"};
+    else {
+        std::string all;
+        int count = 0;
+        for (auto it = channels.begin(); it != channels.end(); ++it, ++count) all += (count ? ", " : "") + std::string(it.name());
+        if (count != 1) throw Error(path + ": EXR image has no R, G, B or Y channels (" + oneLineText(all.substr(0, 200)) + ")");
+        return {all};
+    }
+    if (has("A")) names.push_back("A");
+    return names;
+}
+
+/// One flat scan-line or tiled EXR part, any pixel type, converted to float by OpenEXR.
+Image readExr(const std::string& path) {
+    limitOpenExr();
+    try {
+        Imf::MultiPartInputFile file(path.c_str());
+        if (file.parts() != 1) throw Error(path + ": holds several images (" + std::to_string(file.parts()) + " parts); expected one");
+        const Imf::Header& header = file.header(0);
+        if (header.hasType() && (header.type() == Imf::DEEPSCANLINE || header.type() == Imf::DEEPTILE))
+            throw Error(path + ": is a deep image; only flat PNG or EXR images can be compared");
+        const Imath::Box2i window = header.dataWindow();
+        const int64_t w = int64_t(window.max.x) - window.min.x + 1, h = int64_t(window.max.y) - window.min.y + 1;
+        checkImageSize(w, h, path);
+        const std::vector<std::string> names = exrChannels(header.channels(), path);
+        std::vector<float> data(size_t(w) * size_t(h) * names.size());
+        Imf::FrameBuffer frame;
+        const size_t xStride = sizeof(float) * names.size(), yStride = xStride * size_t(w);
+        for (size_t c = 0; c < names.size(); ++c)
+            frame.insert(names[c], Imf::Slice::Make(Imf::FLOAT, data.data() + c, window, xStride, yStride));
+        Imf::InputPart part(file, 0);
+        part.setFrameBuffer(frame);
+        part.readPixels(window.min.y, window.max.y);
+        Image image(static_cast<int>(w), static_cast<int>(h));
+        const bool grey = names[0] != "R";
+        const bool alpha = names.back() == "A";
+        for (size_t i = 0; i < image.pixels.size(); ++i) {
+            const float* p = &data[i * names.size()];
+            image.pixels[i] = grey ? glm::vec4(p[0], p[0], p[0], alpha ? p[1] : 1.0f)
+                                   : glm::vec4(p[0], p[1], p[2], alpha ? p[3] : 1.0f);
+        }
+        return image;
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(path + ": cannot read EXR: " + oneLineText(e.what()));
+    }
 }
 }  // namespace
 
@@ -170,22 +243,10 @@ void writeImage(const std::string& path, const Image& image, const std::map<std:
     checkImagePath(path);
     const std::string ext = extensionOf(path);
     const std::string target = resolveOutputPath(path);
-    // Same folder so the rename is atomic; the extension stays last so OIIO knows the format.
-    const std::string tmp = temporaryPathFor(target, ext);
+    const std::string tmp = temporaryPathFor(target, ext);  // same folder: the rename is atomic
     try {
-        if (ext == ".png") {
-            OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-            std::vector<unsigned char> bytes(size_t(image.width) * image.height * 3);
-            for (size_t i = 0; i < image.pixels.size(); ++i)
-                for (int c = 0; c < 3; ++c)
-                    bytes[3 * i + c] = static_cast<unsigned char>(std::lround(255.0f * linearToSrgb(image.pixels[i][c])));
-            writeWith(tmp, path, "png", spec, bytes.data());
-        } else {
-            OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
-            for (const auto& [key, value] : metadata) spec.attribute("vdbsplat:" + key, value);
-            spec.attribute("compression", "zip");
-            writeWith(tmp, path, "openexr", spec, image.pixels.data());
-        }
+        if (ext == ".png") writePng(tmp, path, image);
+        else writeExr(tmp, path, image, metadata);
         renameIntoPlace(tmp, target, path);
     } catch (...) {
         std::remove(tmp.c_str());
@@ -194,23 +255,12 @@ void writeImage(const std::string& path, const Image& image, const std::map<std:
 }
 
 Image readImage(const std::string& path) {
-    const std::unique_ptr<OIIO::ImageInput> in = openPngOrExr(path);
-    const OIIO::ImageSpec spec = in->spec();
-    checkInputSpec(*in, spec, path);
-    const int nc = spec.nchannels;
-    std::vector<float> data(size_t(spec.width) * spec.height * nc);
-    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data())) throw Error(path + ": cannot decode: " + oneLineText(in->geterror()));
-    const bool srgb = std::string(in->format_name()) != "openexr";  // by content, not by name
-    Image image(spec.width, spec.height);
-    for (size_t i = 0; i < image.pixels.size(); ++i) {
-        glm::vec4 p(0.0f, 0.0f, 0.0f, 1.0f);
-        for (int c = 0; c < std::min(nc, 4); ++c) p[c] = data[i * nc + c];
-        if (nc == 1) p = glm::vec4(p.x, p.x, p.x, 1.0f);
-        if (srgb)
-            for (int c = 0; c < 3; ++c) p[c] = srgbToLinear(p[c]);
-        image.pixels[i] = p;
-    }
-    return image;
+    const std::vector<unsigned char> sig = signatureOf(path);
+    if (isPng(sig)) return readPng(path);
+    if (isExr(sig)) return readExr(path);
+    if (!std::filesystem::exists(path)) throw Error(path + ": cannot read image: no such file");
+    if (isVdb(sig)) throw Error(path + ": is a VDB file (a volume image), not a 2D PNG or EXR");
+    throw Error(path + ": not a PNG or EXR image (unrecognised content)");
 }
 
 }  // namespace vdbsplat

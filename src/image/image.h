@@ -1,8 +1,8 @@
 // image/image.h — the output image and its files.
 // Owns: Image (linear, premultiplied RGBA float, row-major, y down) and writing
-// it as PNG (8-bit, sRGB-encoded, over black) or EXR (float, linear, with
-// metadata) through OpenImageIO, atomically: a temporary file in the same
-// folder, renamed into place, so a failure never leaves a partial image.
+// it as PNG (8-bit, sRGB-encoded, over black; libpng) or EXR (float, linear, with
+// metadata; OpenEXR), atomically: a temporary file in the same folder, renamed into
+// place, so a failure never leaves a partial image; reading PNG or EXR back (`compare`).
 #pragma once
 #include <glm/glm.hpp>
 #include <cstdint>
@@ -40,8 +40,7 @@ void writeImage(const std::string& path, const Image& image,
                 const std::map<std::string, std::string>& metadata = {});
 
 /// @brief Reads a PNG (sRGB, decoded to linear) or EXR (linear) back into an Image.
-/// The format is chosen by content (PNG or EXR only; OpenImageIO's other readers are never
-/// tried). @throw Error naming the path when it cannot be read, or before reading pixels when
+/// The format is chosen by content (PNG or EXR only). @throw Error naming the path when it cannot be read, or before reading pixels when
 /// it is not one flat 2D image (a volume, deep or multi-image file) or a side exceeds kMaxImageSide.
 Image readImage(const std::string& path);
 

@@ -11,7 +11,7 @@
 // the reference integrate the same field of σ_k and c_k, only c_k (and σ_k with gradient
 // opacity) now depend on the neighbours and the eye.
 #pragma once
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <glm/glm.hpp>
 

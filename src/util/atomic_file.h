@@ -36,7 +36,7 @@ OutputKind checkOutputPath(const std::string& path);
 void checkRegularOutputPath(const std::string& path, const std::string& flag = "");
 
 /// @brief A temporary name beside @p target (same folder, so rename is atomic), ending in
-/// @p suffix (OpenImageIO picks the format by extension).
+/// @p suffix (the image writers keep the extension last).
 std::string temporaryPathFor(const std::string& target, const std::string& suffix = "");
 
 /// @brief Renames @p tmp onto @p target; removes @p tmp and throws Error naming

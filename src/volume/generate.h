@@ -10,7 +10,7 @@
 // Every grid is built leaf by leaf (8³) in parallel and inserted in a fixed order,
 // so the result is identical for any thread count and never densified.
 #pragma once
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <cstdint>
 #include <optional>

@@ -4,7 +4,7 @@
 // double is converted to a float tree of the same topology), validating its
 // transform, and describing every grid of a file (`vdbsplat info`).
 #pragma once
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <glm/glm.hpp>
 #include <string>

@@ -12,7 +12,7 @@
 // it (pread, chunk by chunk) and gives back each chunk of leaves (hole punch) once that chunk
 // is in the tree, so the transfer and the tree are never both whole in memory.
 #pragma once
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <cstdint>
 #include <functional>

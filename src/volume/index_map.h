@@ -4,7 +4,7 @@
 // origin bounded, axes not singular). Non-uniform and rotated axes are kept: converting is
 // allowed; `render` accepts rotations with cubic voxels and refuses non-uniform voxel sizes.
 #pragma once
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <array>
 #include <string>

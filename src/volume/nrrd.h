@@ -6,7 +6,7 @@
 // geometry as the grid's transform. The voxels go through readVoxels (volume/raw.h), so a
 // NRRD converts to exactly the grid the same data gives as raw.
 #pragma once
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <string>
 

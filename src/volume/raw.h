@@ -7,7 +7,7 @@
 // (default 0, so zeros are background and stay inactive); non-finite values (and float64
 // values beyond float32's range) stay inactive and are counted.
 #pragma once
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <array>
 #include <cstdint>

@@ -7,7 +7,7 @@
 // headers. Decoded bytes go through DensityBuilder (volume/raw.h), so a .vti converts to
 // exactly the grid the same data gives as raw.
 #pragma once
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <string>
 

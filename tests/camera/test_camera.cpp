@@ -6,7 +6,7 @@
 // through render's cameraFor (index→world itself is covered in tests/volume/test_grid.cpp).
 #include <gtest/gtest.h>
 
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>

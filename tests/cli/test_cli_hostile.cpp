@@ -4,7 +4,7 @@
 // that hung or ran for minutes before the fix run under `timeout`, so a regression fails
 // (exit 124) instead of stalling the suite. docs/robustness.md lists them all.
 #include <gtest/gtest.h>
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 #include <zlib.h>
 
 #include <climits>
@@ -96,7 +96,8 @@ std::string pngHeaderOnly(uint32_t w, uint32_t h) {
 
 // --- compare ---------------------------------------------------------------------------
 
-// OpenImageIO opens a .vdb named .png as a 33³ volume image: readImage wrote past its buffer.
+// OpenImageIO (the image library before libpng and OpenEXR) opened a .vdb named .png as a 33³
+// volume image: readImage wrote past its buffer.
 TEST_F(CliHostile, CompareRefusesAVolumeImage) {
     writeImage(path("a.png"), Image(33, 33));
     fs::copy_file(sphere("s.vdb", 33), path("b.png"));

@@ -1,5 +1,5 @@
 // tests/fuzz/fuzz_image.cpp — libFuzzer target: `vdbsplat compare`'s input (readImage,
-// through OpenImageIO: PNG, EXR and whatever else it recognises by content). The first
+// PNG through libpng, EXR through OpenEXR, chosen by content). The first
 // byte picks the extension. Findings inside libpng/OpenEXR are reported, not ours to fix.
 #include <cstddef>
 #include <cstdint>

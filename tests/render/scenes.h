@@ -1,6 +1,6 @@
 // tests/render/scenes.h — small in-memory scenes with known answers for render tests.
 #pragma once
-#include <openvdb/openvdb.h>
+#include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 #include <openvdb/math/Transform.h>
 
 #include "volume/grid.h"
