@@ -73,10 +73,10 @@ struct RenderSettings {
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
     /// Level of detail for minified voxels (DESIGN §8.2): points are aggregated over cells of
     /// 2, 4 or 8 voxels per side whose side projects to at most this many pixels; 0: off.
-    /// 2 (it was 1): the cap; the level is chosen by the spread a cell adds beside the points'
-    /// filter (kLodMaxSpreadRatio, volume/stream.h), so a 2³ cell of 0.6 px voxels (a 1024² far
-    /// view) is aggregated and an 8³ cell of 0.15 px voxels is not (docs/performance.md, session 3).
-    double lodPx = 2.0;
+    /// 1.25 (it was 1): a 2³ cell of 0.6 px voxels (a 1024² far view) is aggregated; within the
+    /// cap the spread a cell adds beside the points' filter decides (kLodMaxSpreadRatio,
+    /// volume/stream.h), so an 8³ cell of 0.15 px voxels is not (docs/performance.md, session 3).
+    double lodPx = 1.25;
     /// Splats through the vector loop (Highway, polynomial footprint); false: the scalar table
     /// path it is tested against (same image to ~1e−6; for measuring).
     bool simd = true;
