@@ -41,6 +41,14 @@ Camera::Camera(const glm::dvec3& eye, const glm::dvec3& lookAt, const glm::dvec3
     principal_ = {0.5 * width, 0.5 * height};
 }
 
+Camera Camera::cropped(int x0, int y0, int width, int height) const {
+    if (width < 1 || height < 1) throw Error("camera crop: the rectangle is empty");
+    Camera c = *this;
+    c.width_ = width, c.height_ = height;
+    c.principal_ = principal_ - PixelCoord(x0, y0);
+    return c;
+}
+
 std::string Camera::describe() const {
     std::ostringstream s;
     s.precision(9);

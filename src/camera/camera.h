@@ -63,6 +63,11 @@ public:
     int width() const { return width_; }
     int height() const { return height_; }
     double fovDeg() const { return fovDeg_; }
+    /// @brief The same camera (eye, axes, focal length) seeing only the pixels
+    /// [@p x0, @p x0 + @p width) × [@p y0, @p y0 + @p height) of this one: pixel (x, y) of the
+    /// crop is pixel (x0 + x, y0 + y) here (the principal point moves by (−x0, −y0)).
+    /// @throw Error when the crop is empty.
+    Camera cropped(int x0, int y0, int width, int height) const;
     /// @brief One line describing the camera (for EXR metadata and stats).
     std::string describe() const;
 

@@ -94,7 +94,7 @@ const char* kHelp =
     "  --fov DEG          vertical field of view (default 30; --path: for keys without fov)\n"
     "  --distance K       orbit: framing distance (default 1)\n"
     "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
-    "  --lod PX           level-of-detail cell size in pixels (default 1; 0: off; see render --help)\n"
+    "  --lod PX           level-of-detail cell size in pixels (default 1.25; 0: off; see render --help)\n"
     "  --simd on|off      splats through the vector loop (default on) or the scalar table path\n"
     "  --footprint P      auto (default) | table | exact (see render --help)\n"
     "  --filter-order O   postfilter (default) | prefilter; --subpixels K (see render --help)\n"

@@ -57,7 +57,7 @@ const char* kHelp =
     "  --view-dir X,Y,Z     framing direction, centre to eye (default 0.9,-1.3,0.75)\n"
     "  --up X,Y,Z           up vector (default 0,0,1)\n"
     "  --threshold PX       minification threshold of hybrid mode in pixels (default 1)\n"
-    "  --lod PX             level-of-detail cell size in pixels (default 1; 0: off; see render --help)\n"
+    "  --lod PX             level-of-detail cell size in pixels (default 1.25; 0: off; see render --help)\n"
     "  --simd on|off        vector splat loop (default on) or the scalar table path\n"
     "  --footprint P        auto (default) | table | exact (see render --help)\n"
     "  --filter-order O     postfilter (default) | prefilter; --subpixels K (see render --help)\n"

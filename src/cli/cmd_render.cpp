@@ -40,7 +40,7 @@ const char* kHelp =
     "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
     "  --lod PX           level of detail: points are merged into aggregates of 2^3, 4^3 or 8^3 voxels\n"
     "                     (same total optical depth, centroid and spread) whose side projects to at\n"
-    "                     most PX pixels (default 1; 0 turns it off)\n"
+    "                     most PX pixels (default 1.25; 0 turns it off)\n"
     "  --simd on|off      splats through the vector loop (default on) or the scalar table path\n"
     "  --footprint P      auto (default): the (i, alpha) reindex table, and the exact ray-centre\n"
     "                     distance for splats far off the axis where the affine index is off;\n"

@@ -7,8 +7,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "composite/compositor.h"
+#include "footprint/kernel.h"
+#include "footprint/pixel_box.h"
 #include "render/postfilter.h"
 #include "render/project.h"
 #include "volume/stream.h"
@@ -60,6 +63,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
                 const VoxelShader* shader, const RenderControl& control) {
     StreamOptions streamOptions = settings.stream;
     streamOptions.lodCellPx = pass.lodPx;
+    streamOptions.pointPrefilterVariance = pass.prefilterVariance;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point   ? INFINITY
                                  : settings.mode == RenderMode::Splat ? 0.0
                                                                       : pass.threshold;
@@ -101,7 +105,52 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     stats.culledOccluded = stream.counts().occluded;
     stats.windows = stream.windows();
     stats.largestWindow = stream.largestWindow();
+    stats.compositedPixels = uint64_t(camera.width()) * uint64_t(camera.height());
     return compositor.image();
+}
+
+/// How far (px) past the projection of a primitive's kernel sphere its deposits reach: a point's
+/// filter r_s ≤ kPointMaxRadiusPx (pointfilter/point_filter.h); a splat's support ellipse
+/// widened by V (screen_kernel.cpp: a' = √(a² + (R/s_g)²·V) ≤ a + (R/s_g)·√V); one pixel to spare.
+double depositReachPx(double prefilterVariance) {
+    return std::max(kPointMaxRadiusPx, Kernel::kRadius / Kernel::kSigma * std::sqrt(prefilterVariance)) + 1.0;
+}
+
+/// The pixels of @p camera any primitive of @p volume can touch, grown by @p grow pixels: the
+/// projection of the active voxels' index box widened by the kernel radius (R + ½ voxel; it
+/// holds every voxel's kernel sphere, and a convex set in front of the eye projects inside
+/// its corners' hull), plus the deposits' reach. Nothing when a corner is at or behind the
+/// eye plane (no crop), or when the rectangle is the whole image.
+std::optional<PixelRange> coveredPixels(const Volume& volume, const Camera& camera, const RenderSettings& settings,
+                                        double reachPx, int grow) {
+    if (!settings.cropToVolume) return std::nullopt;
+    const openvdb::CoordBBox& box = volume.indexBox;
+    const double r = Kernel::kRadius + 0.5;
+    PixelBox hull;
+    hull.lo = PixelCoord(INFINITY), hull.hi = PixelCoord(-INFINITY);
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 idx(corner & 1 ? box.max().x() + r : box.min().x() - r,
+                             corner & 2 ? box.max().y() + r : box.min().y() - r,
+                             corner & 4 ? box.max().z() + r : box.min().z() - r);
+        const ViewPoint v = camera.toView(glm::dvec3(volume.indexToWorld * glm::dvec4(idx, 1.0)));
+        if (!(v.z > 1e-6 * glm::length(v))) return std::nullopt;
+        const PixelCoord p = camera.project(v);
+        hull.lo = glm::min(hull.lo, p), hull.hi = glm::max(hull.hi, p);
+    }
+    const double m = reachPx + grow;
+    hull.lo -= m, hull.hi += m;
+    const PixelRange range = pixelRange(hull, camera.width(), camera.height());
+    if (range.x0 == 0 && range.y0 == 0 && range.x1 == camera.width() - 1 && range.y1 == camera.height() - 1)
+        return std::nullopt;
+    return range;
+}
+
+/// A @p width × @p height image, transparent (T = 1, no radiance) except for @p part at (@p x0, @p y0).
+Image placed(const Image& part, int x0, int y0, int width, int height) {
+    Image out(width, height);
+    for (int y = 0; y < part.height; ++y)
+        std::copy_n(&part.at(0, y), part.width, &out.at(x0, y0 + y));
+    return out;
 }
 
 }  // namespace
@@ -109,18 +158,38 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     const Tables& tables, const RenderSettings& settings, RenderStats& stats,
                     const VoxelShader* shader, const RenderControl& control) {
-    if (settings.filterOrder == FilterOrder::Prefilter)
-        return composite(volume, table, camera, tables, settings,
-                         ForwardPass{settings.threshold, settings.lodPx, kPrefilterVariance}, stats, shader, control);
+    // Fixed costs follow the pixels the volume covers, not the image: the compositor, its
+    // tiles and the postfilter see only that rectangle (a cropped camera: the same rays, so the
+    // same image there, up to the float rounding of pixel coordinates); the rest is empty.
+    if (settings.filterOrder == FilterOrder::Prefilter) {
+        const ForwardPass pass{settings.threshold, settings.lodPx, kPrefilterVariance};
+        const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance), 0);
+        if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control);
+        const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
+        const Image part = composite(volume, table, camera.cropped(crop->x0, crop->y0, w, h), tables, settings, pass,
+                                     stats, shader, control);
+        return placed(part, crop->x0, crop->y0, camera.width(), camera.height());
+    }
     // Postfilter: the same primitives (τ and the level of detail scaled to sub-pixels, so the
     // same voxels are points), composited at k× the resolution with only V_s folded in, then
     // the rest of the low-pass on the composited image (postfilter.h).
     const SubpixelGrid grid = makeSubpixelGrid(settings.subpixels, kPrefilterVariance);
     const Camera fine = subpixelCamera(camera, grid);
-    const double k = grid.k;
-    const Image sub = composite(volume, table, fine, tables, settings,
-                                ForwardPass{settings.threshold * k, settings.lodPx * k, grid.fineVariance}, stats, shader, control);
-    return postfilterImage(sub, grid, camera.width(), camera.height());
+    const int k = grid.k;
+    const ForwardPass pass{settings.threshold * k, settings.lodPx * k, grid.fineVariance};
+    // Deposits reach depositReachPx sub-pixels (≤ that many pixels) past the kernels; the output
+    // pixels they reach through the filter lie within `border` more; the crop of the sub-pixel
+    // image is that output rectangle with its own border, as subpixelCamera frames the whole image.
+    const std::optional<PixelRange> crop =
+        coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance), grid.border);
+    if (!crop) {
+        const Image sub = composite(volume, table, fine, tables, settings, pass, stats, shader, control);
+        return postfilterImage(sub, grid, camera.width(), camera.height());
+    }
+    const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
+    const Camera fineCrop = fine.cropped(k * crop->x0, k * crop->y0, k * (w + 2 * grid.border), k * (h + 2 * grid.border));
+    const Image sub = composite(volume, table, fineCrop, tables, settings, pass, stats, shader, control);
+    return placed(postfilterImage(sub, grid, w, h), crop->x0, crop->y0, camera.width(), camera.height());
 }
 
 }  // namespace vdbsplat

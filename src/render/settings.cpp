@@ -122,6 +122,7 @@ nlohmann::json RenderStats::toJson() const {
     j["splats_exact_index"] = exactIndexSplats;
     j["windows"] = windows;
     j["largest_window_voxels"] = largestWindow;
+    if (compositedPixels) j["composited_pixels"] = compositedPixels;
     const uint64_t drawn = points + splats;
     j["splat_fraction"] = drawn ? double(splats) / double(drawn) : 0.0;
     if (rays) j["rays"] = rays;

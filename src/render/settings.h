@@ -73,11 +73,18 @@ struct RenderSettings {
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
     /// Level of detail for minified voxels (DESIGN §8.2): points are aggregated over cells of
     /// 2, 4 or 8 voxels per side whose side projects to at most this many pixels; 0: off.
-    double lodPx = 1.0;
+    /// 1.25 (it was 1): a 2³ cell of 0.6 px voxels (a 1024² far view) is aggregated; within the
+    /// cap the spread a cell adds beside the points' filter decides (kLodMaxSpreadRatio,
+    /// volume/stream.h), so an 8³ cell of 0.15 px voxels is not (docs/performance.md, session 3).
+    double lodPx = 1.25;
     /// Splats through the vector loop (Highway, polynomial footprint); false: the scalar table
     /// path it is tested against (same image to ~1e−6; for measuring).
     bool simd = true;
     std::string tablesDir;                  ///< footprint/reindex tables; empty: defaultTablesDir()
+    /// Forward modes: composite only the pixel rectangle the volume's kernels can reach (the rest
+    /// of the image stays empty); false: the whole image, the oracle the crop is tested against
+    /// (same image up to float rounding of pixel coordinates; a speed knob, not in the JSON echo).
+    bool cropToVolume = true;
     StreamOptions stream;                   ///< how the grid is streamed: speed and memory, never the image
     uint64_t maxActiveVoxels = kDefaultMaxActiveVoxels;  ///< larger grids are refused before any work
     ShadingSettings shading;                ///< off by default: the unshaded emission–absorption image
@@ -116,6 +123,7 @@ struct RenderStats {
     uint64_t lodVoxels = 0;           ///< active voxels those aggregates stand for
     uint64_t windows = 0;             ///< forward modes: depth windows streamed
     uint64_t largestWindow = 0;       ///< forward modes: most voxels in one window
+    uint64_t compositedPixels = 0;    ///< forward modes: pixels (sub-pixels) the compositor held (the crop)
     uint64_t rays = 0;  ///< reference: rays traced
     int raysPerPixel = 0;  ///< reference: the --spp actually used (rounded up to a square)
     double shadingSeconds = 0.0;  ///< the shading pass (0 when shading is off)

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "footprint/kernel.h"
+#include "pointfilter/point_filter.h"
 #include "shading/shading_field.h"
 #include "util/error.h"
 
@@ -114,13 +115,14 @@ bool VoxelStream::visible(const Block& b) const {
     const glm::dvec3 c = camera_.toView(glm::dvec3(volume_.indexToWorld * glm::dvec4(centreIdx, 1.0)));
     const double radius = (0.5 * (b.dim - 1) * std::sqrt(3.0) + Kernel::kRadius) * h;
     if (c.z < -radius) return false;  // entirely behind the eye
-    // Side planes of the frustum widened by the screen margin: x = ±z·tx, y = ±z·ty.
-    const double tx = (0.5 * camera_.width() + options_.screenMargin) / camera_.focal();
-    const double ty = (0.5 * camera_.height() + options_.screenMargin) / camera_.focal();
-    const double nx = 1.0 / std::sqrt(1.0 + tx * tx), ny = 1.0 / std::sqrt(1.0 + ty * ty);
-    if ((std::abs(c.x) - tx * c.z) * nx > radius) return false;
-    if ((std::abs(c.y) - ty * c.z) * ny > radius) return false;
-    return true;
+    // Side planes of the frustum widened by the screen margin, x = z·t for the slopes t of the
+    // image's edges (the principal point need not be centred: a cropped camera).
+    const double m = options_.screenMargin, f = camera_.focal();
+    const PixelCoord p = camera_.principal();
+    const double left = (p.x + m) / f, right = (camera_.width() - p.x + m) / f;  // x ∈ [−z·left, z·right]
+    const double top = (p.y + m) / f, bottom = (camera_.height() - p.y + m) / f;  // y ∈ [−z·bottom, z·top]
+    const auto outside = [&](double u, double t) { return (u - t * c.z) / std::sqrt(1.0 + t * t) > radius; };
+    return !outside(c.x, right) && !outside(-c.x, left) && !outside(c.y, top) && !outside(-c.y, bottom);
 }
 
 void VoxelStream::screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const {
@@ -159,8 +161,16 @@ int VoxelStream::lodLevel(const Block& b) const {
     if (!(zNear > 0.0)) return 0;
     const double spacingPx = h * camera_.focal() / zNear;  // the block's largest projected voxel spacing
     if (!(spacingPx < options_.pointBelowPx)) return 0;     // some voxel may be a splat
+    // A cell of n = 2^L voxels per side, uniform, adds the spread s²·(n² − 1)/12 px² per axis
+    // (s the projected spacing): at most kLodMaxSpreadRatio of the points' own filter variance.
+    const double filter = pointFilterVariance(spacingPx, options_.pointPrefilterVariance);
     int level = 0;
-    while (level < 3 && double(2 << level) * spacingPx <= options_.lodCellPx) ++level;
+    while (level < 3) {
+        const double n = double(2 << level);
+        const double spread = spacingPx * spacingPx * (n * n - 1.0) / 12.0;
+        if (n * spacingPx > options_.lodCellPx || spread > kLodMaxSpreadRatio * filter) break;
+        ++level;
+    }
     return level;
 }
 
@@ -179,6 +189,11 @@ void VoxelStream::forEachActive(const Block& b, Fn&& fn) const {
     };
     if (b.leaf) {
         const float* values = b.leaf->buffer().data();
+        if (b.voxels == openvdb::FloatTree::LeafNodeType::SIZE) {  // dense leaf: no mask walk
+            for (openvdb::Index n = 0; n < openvdb::FloatTree::LeafNodeType::SIZE; ++n)
+                fn(int(n >> 6), int((n >> 3) & 7), int(n & 7), classify(n, values[n]));
+            return;
+        }
         for (auto it = b.leaf->getValueMask().beginOn(); it; ++it) {
             const openvdb::Index n = it.pos();  // x·64 + y·8 + z
             fn(int(n >> 6), int((n >> 3) & 7), int(n & 7), classify(n, values[n]));

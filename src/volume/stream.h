@@ -45,6 +45,14 @@ struct VoxelBatch {
     void resize(size_t n);  ///< every array to @p n records
 };
 
+/// Level of detail: the largest spread an aggregate may add, as a fraction of the filter
+/// variance of the points it replaces. An aggregate keeps the energy and the second moment, but
+/// not the order of its voxels in depth nor the lumps of their separate footprints; where the
+/// spread is small beside the filter neither shows. Measured (far views, postfilter, PSNR
+/// against the reference, each level against --lod 0): ratios 0.22–0.54 cost −0.7…+0.5 dB,
+/// ratios 1.1–2.3 cost −0.4…−8.7 dB (docs/performance.md, session 3).
+inline constexpr double kLodMaxSpreadRatio = 0.75;
+
 struct StreamOptions {
     double slabThickness = 1.0;  ///< slab thickness in voxels (points are summed within one slab)
     int slabsPerWindow = 8;      ///< a window is this many slabs (more when they are nearly empty)
@@ -56,8 +64,12 @@ struct StreamOptions {
     size_t maxWindowVoxels = 1 << 20;
     double screenMargin = 4.0;   ///< pixels of margin around the image for frustum culling
     /// Level of detail: aggregate cells of 2^L voxels per side whose side projects to at most
-    /// this many pixels (0: off). Only blocks whose voxels are all points are aggregated.
+    /// this many pixels (0: off). Only blocks whose voxels are all points are aggregated, and
+    /// only while the spread a cell adds stays within kLodMaxSpreadRatio of the variance of the
+    /// points it replaces (pointFilterVariance with the pass's low-pass below).
     double lodCellPx = 1.0;
+    /// The low-pass folded into each point (px²: V_h, or V_s on the postfilter's sub-pixel grid).
+    double pointPrefilterVariance = 1.0;
     /// Voxels whose projected spacing h·f/z is under this many pixels are drawn as points by
     /// the renderer (hybrid: its threshold τ; point mode: +∞; splat mode: 0, no aggregates).
     double pointBelowPx = 0.0;
