@@ -17,6 +17,7 @@
 #include <png.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -25,6 +26,7 @@
 
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/parse.h"
 
 namespace vdbsplat {
 
@@ -35,16 +37,13 @@ std::string extensionOf(const std::string& path) {
     return ext;
 }
 
-/// A library's message on one line, naming the user's @p path where it names @p tmp.
+/// A library's message naming the user's @p path where it names the temporary @p tmp. (Line
+/// breaks and control characters are escaped where every error is printed, cli/main.cpp.)
 std::string renamed(std::string message, const std::string& tmp, const std::string& path) {
-    for (size_t at = message.find(tmp); !tmp.empty() && at != std::string::npos; at = message.find(tmp, at + path.size()))
+    for (size_t at = message.find(tmp); at != std::string::npos; at = message.find(tmp, at + path.size()))
         message.replace(at, tmp.size(), path);
-    for (char& c : message)
-        if (c == '\n' || c == '\r') c = ' ';
     return message;
 }
-
-std::string oneLineText(std::string s) { return renamed(std::move(s), "", ""); }
 
 std::string sizeText(int64_t w, int64_t h) { return std::to_string(w) + "x" + std::to_string(h); }
 
@@ -87,7 +86,7 @@ struct PngImage {
     png_image image{};
     PngImage() { image.version = PNG_IMAGE_VERSION; }
     ~PngImage() { png_image_free(&image); }
-    std::string message() const { return image.message[0] ? oneLineText(image.message) : "unknown libpng error"; }
+    std::string message() const { return image.message[0] ? std::string(image.message) : "unknown libpng error"; }
 };
 
 void writePng(const std::string& tmp, const std::string& path, const Image& image) {
@@ -154,11 +153,11 @@ Image readPng(const std::string& path) {
         std::vector<png_byte> data(PNG_IMAGE_SIZE(png.image));
         if (!png_image_finish_read(&png.image, nullptr, data.data(), 0, nullptr))
             throw Error(path + ": cannot decode PNG: " + png.message());
+        std::array<float, 256> linear;  // the sRGB curve of each 8-bit code, once
+        for (int code = 0; code < 256; ++code) linear[code] = srgbToLinear(code / 255.0f);
         for (size_t i = 0; i < image.pixels.size(); ++i) {
             const float alpha = data[4 * i + 3] / 255.0f;
-            glm::vec4 p(0.0f, 0.0f, 0.0f, alpha);
-            for (int c = 0; c < 3; ++c) p[c] = srgbToLinear(data[4 * i + c] / 255.0f) * alpha;
-            image.pixels[i] = p;
+            image.pixels[i] = glm::vec4(linear[data[4 * i]], linear[data[4 * i + 1]], linear[data[4 * i + 2]], 1.0f) * alpha;
         }
     }
     return image;
@@ -175,7 +174,7 @@ std::vector<std::string> exrChannels(const Imf::ChannelList& channels, const std
         std::string all;
         int count = 0;
         for (auto it = channels.begin(); it != channels.end(); ++it, ++count) all += (count ? ", " : "") + std::string(it.name());
-        if (count != 1) throw Error(path + ": EXR image has no R, G, B or Y channels (" + oneLineText(all.substr(0, 200)) + ")");
+        if (count != 1) throw Error(path + ": EXR image has no R, G, B or Y channels (" + printable(all, 200) + ")");
         return {all};
     }
     if (has("A")) names.push_back("A");
@@ -215,7 +214,7 @@ Image readExr(const std::string& path) {
     } catch (const Error&) {
         throw;
     } catch (const std::exception& e) {
-        throw Error(path + ": cannot read EXR: " + oneLineText(e.what()));
+        throw Error(path + ": cannot read EXR: " + std::string(e.what()));
     }
 }
 }  // namespace
