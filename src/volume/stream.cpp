@@ -19,11 +19,6 @@ namespace vdbsplat {
 namespace {
 constexpr int kBlockDim = 8;  // OpenVDB leaf side; active tiles are split into blocks of this side
 constexpr uint64_t kMaxActiveVoxels = uint64_t(1) << 32;
-
-template <typename T>
-void appendRange(std::vector<T>& dst, const std::vector<T>& src, size_t begin, size_t end) {
-    dst.insert(dst.end(), src.begin() + begin, src.begin() + end);
-}
 }  // namespace
 
 void VoxelBatch::resize(size_t n) {
@@ -336,6 +331,57 @@ void VoxelStream::adaptWindow(size_t released) {
         slabsPerWindow_ = std::min(widest, 2 * slabsPerWindow_);
 }
 
+namespace {
+/// Record @p i of @p src appended at @p k of @p dst (already sized).
+void copyRecord(const VoxelBatch& src, size_t i, VoxelBatch& dst, size_t k) {
+    dst.viewPos[k] = src.viewPos[i];
+    dst.distance[k] = src.distance[i];
+    dst.sigma[k] = src.sigma[i];
+    dst.color[k] = src.color[i];
+    dst.spread[k] = src.spread[i];
+    dst.members[k] = src.members[i];
+}
+}  // namespace
+
+// The sources, in order: the pending voxels in fixed chunks, then each new block's voxels. Each
+// source's released (distance < limit) and kept counts, prefix sums, then every source copies its
+// records to its offsets in parallel: the same order as a serial append-and-partition, so the
+// batches do not depend on the thread count.
+void VoxelStream::release(size_t blocks, float limit, VoxelBatch& batch) {
+    constexpr size_t kChunk = 4096;
+    const size_t pendingChunks = (pending_.size() + kChunk - 1) / kChunk, sources = pendingChunks + blocks;
+    const auto source = [&](size_t s, size_t& begin, size_t& end) -> const VoxelBatch& {
+        if (s < pendingChunks) {
+            begin = s * kChunk, end = std::min(pending_.size(), begin + kChunk);
+            return pending_;
+        }
+        const VoxelBatch& e = extracted_[s - pendingChunks];
+        begin = 0, end = e.size();
+        return e;
+    };
+    std::vector<size_t> released(sources + 1, 0), kept(sources + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, sources, 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t s = r.begin(); s < r.end(); ++s) {
+            size_t begin, end, n = 0;
+            const VoxelBatch& src = source(s, begin, end);
+            for (size_t i = begin; i < end; ++i) n += src.distance[i] < limit ? 1 : 0;
+            released[s + 1] = n, kept[s + 1] = (end - begin) - n;
+        }
+    });
+    for (size_t s = 0; s < sources; ++s) released[s + 1] += released[s], kept[s + 1] += kept[s];
+    batch.resize(released[sources]);
+    pendingNext_.resize(kept[sources]);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, sources, 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t s = r.begin(); s < r.end(); ++s) {
+            size_t begin, end, out = released[s], stay = kept[s];
+            const VoxelBatch& src = source(s, begin, end);
+            for (size_t i = begin; i < end; ++i)
+                src.distance[i] < limit ? copyRecord(src, i, batch, out++) : copyRecord(src, i, pendingNext_, stay++);
+        }
+    });
+    std::swap(pending_, pendingNext_);
+}
+
 bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden) {
     batch.clear();
     while (true) {
@@ -377,41 +423,16 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
             }
         });
         for (size_t i = first; i < nextBlock_; ++i) {
-            const VoxelBatch& e = extracted_[i - first];
             if (skipped_[i - first]) counts_.occluded += blocks_[i].voxels;
             if (blocks_[i].lodLevel > 0) {
+                const VoxelBatch& e = extracted_[i - first];
                 counts_.aggregates += e.size();
                 for (uint32_t n : e.members) counts_.aggregatedVoxels += n;
             }
-            appendRange(pending_.viewPos, e.viewPos, 0, e.size());
-            appendRange(pending_.distance, e.distance, 0, e.size());
-            appendRange(pending_.sigma, e.sigma, 0, e.size());
-            appendRange(pending_.color, e.color, 0, e.size());
-            appendRange(pending_.spread, e.spread, 0, e.size());
-            appendRange(pending_.members, e.members, 0, e.size());
         }
-        // Release the pending voxels inside the window; compact the rest in place, in order.
-        const float limit = float(slabEnd * slabLength_);
-        size_t kept = 0;
-        for (size_t i = 0; i < pending_.size(); ++i) {
-            if (pending_.distance[i] < limit) {
-                batch.viewPos.push_back(pending_.viewPos[i]);
-                batch.distance.push_back(pending_.distance[i]);
-                batch.sigma.push_back(pending_.sigma[i]);
-                batch.color.push_back(pending_.color[i]);
-                batch.spread.push_back(pending_.spread[i]);
-                batch.members.push_back(pending_.members[i]);
-            } else {
-                pending_.viewPos[kept] = pending_.viewPos[i];
-                pending_.distance[kept] = pending_.distance[i];
-                pending_.sigma[kept] = pending_.sigma[i];
-                pending_.color[kept] = pending_.color[i];
-                pending_.spread[kept] = pending_.spread[i];
-                pending_.members[kept] = pending_.members[i];
-                ++kept;
-            }
-        }
-        pending_.resize(kept);
+        // Release the voxels inside the window (pending first, then the new blocks in order);
+        // the rest stays pending, in the same order.
+        release(count, float(slabEnd * slabLength_), batch);
         batch.slabBegin = nextSlab_;
         batch.slabEnd = slabEnd;
         nextSlab_ = slabEnd;

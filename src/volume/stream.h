@@ -122,6 +122,7 @@ private:
     void extractAggregates(const Block& b, VoxelBatch& out) const;
     template <typename Fn> void forEachActive(const Block& b, Fn&& fn) const;
     void adaptWindow(size_t released);  // the next window's slab count from this one's size
+    void release(size_t blocks, float limit, VoxelBatch& batch);  // pending + extracted → batch, pending
 
     const Volume& volume_;
     const Camera& camera_;
@@ -132,6 +133,7 @@ private:
     std::vector<Block> blocks_;   // sorted by dMin
     size_t nextBlock_ = 0;
     VoxelBatch pending_;          // voxels of activated blocks not yet released
+    VoxelBatch pendingNext_;      // the pending voxels a window keeps (swapped with pending_)
     std::vector<VoxelBatch> extracted_;  // per activated block of the window (reused)
     std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
     int64_t nextSlab_ = 0;
