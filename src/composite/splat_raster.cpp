@@ -8,6 +8,7 @@
 #include <hwy/contrib/math/math-inl.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "composite/opacity.h"
@@ -153,15 +154,31 @@ template <class D>
 void DrawSplatRowsFor(D d, const SplatRaster& s, const TileBuffers& tile) {
 #if HWY_TARGET != HWY_SCALAR
     if constexpr (hn::MaxLanes(D()) == kStride) {
-        // Rows with a chord, and where an 8-pixel window starting at the chord holds it.
+        // Every row's chord at once (rowChord's arithmetic, one lane per row of the tile), then
+        // the rows with a chord, and whether an 8-pixel window from each chord's start holds it.
         constexpr int kHalf = kStride / 2;
+        const hn::RebindToSigned<D> di;
+        const auto dy = hn::Sub(hn::Iota(d, float(s.y0) + 0.5f), hn::Set(d, s.cy));
+        const auto b = hn::Mul(hn::Set(d, s.qxy), dy);
+        const auto disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, s.qxx), hn::Sub(hn::Mul(hn::Mul(hn::Set(d, s.qyy), dy), dy), hn::Set(d, 1.f))));
+        const auto has = hn::And(hn::Gt(disc, hn::Zero(d)), hn::FirstN(d, size_t(s.y1 - s.y0 + 1)));
+        const auto root = hn::Sqrt(hn::Max(disc, hn::Zero(d)));
+        const auto base = hn::Set(d, s.cx - 0.5f), qxx = hn::Set(d, s.qxx);
+        const auto lo = hn::Add(base, hn::Div(hn::Sub(hn::Neg(b), root), qxx));
+        const auto hi = hn::Add(base, hn::Div(hn::Sub(root, b), qxx));
+        alignas(64) int32_t xaAll[kStride], xbAll[kStride];
+        hn::Store(hn::ConvertTo(di, hn::Max(hn::Floor(lo), hn::Set(d, float(s.x0)))), di, xaAll);
+        hn::Store(hn::ConvertTo(di, hn::Min(hn::Ceil(hi), hn::Set(d, float(s.x1)))), di, xbAll);
+        uint8_t hasBits[8] = {};
+        hn::StoreMaskBits(d, has, hasBits);
+        const unsigned rowsWithChord = unsigned(hasBits[0]) | unsigned(hasBits[1]) << 8;
         int rows[kStride], starts[kStride], xas[kStride], xbs[kStride], count = 0;
-        bool narrow = s.y1 - s.y0 < kStride;
-        for (int y = s.y0; narrow && y <= s.y1; ++y) {
-            int xa, xb;
-            if (!rowChord(s, float(y) + 0.5f - s.cy, xa, xb)) continue;
+        bool narrow = true;
+        for (unsigned m = rowsWithChord; m != 0 && narrow; m &= m - 1) {
+            const int k = std::countr_zero(m), xa = xaAll[k], xb = xbAll[k];
+            if (xa > xb) continue;
             if (xb - xa >= kHalf) narrow = false;
-            rows[count] = y, xas[count] = xa, xbs[count] = xb;
+            rows[count] = s.y0 + k, xas[count] = xa, xbs[count] = xb;
             starts[count] = std::min(xa - tile.x0, kHalf);  // [start, start + 8) ⊇ [xa, xb] − x0, inside the row
             ++count;
         }
