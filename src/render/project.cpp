@@ -15,6 +15,13 @@ namespace vdbsplat {
 
 namespace {
 
+/// floor(x) for a finite x within ±2⁶² (a distance over a slab length): a cast and a compare,
+/// not a libm call.
+int64_t floorToInt64(double x) {
+    const int64_t i = int64_t(x);
+    return i - (double(i) > x ? 1 : 0);
+}
+
 /// --show-primitives: splats tinted red (Yuan et al. 2003, Figure 8a), points unchanged.
 glm::vec3 splatTint(const glm::vec3& c) {
     const float luma = std::max(0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z, 0.25f);
@@ -94,7 +101,7 @@ std::span<const Primitive> projectBatch(const VoxelBatch& batch, const Projectio
             Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
             p.members = batch.members[i];
             p.depth = batch.distance[i];
-            p.slab = std::clamp<int64_t>(int64_t(std::floor(batch.distance[i] / ctx.slabLength)), batch.slabBegin,
+            p.slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
                                          batch.slabEnd - 1);
             prims[i] = p;
         }
