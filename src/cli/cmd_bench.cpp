@@ -173,6 +173,7 @@ Options optionsFrom(const Args& args) {
         std::error_code ec;
         if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) throw Error(*o.json + ": folder does not exist");
         checkOutputPath(*o.json);  // a directory or dangling link fails before the benchmark
+        checkNotAnInput(*o.json, o.input, "--json");
     }
     return o;
 }

@@ -107,6 +107,7 @@ int runConvert(const Argv& argv) {
     const std::string out = args.require("-o");
     const ConvertOptions options = optionsFrom(args);
     checkRegularOutputPath(out, "-o");
+    checkNotAnInput(out, in, "-o");
     const auto start = std::chrono::steady_clock::now();
     RawStats stats;
     auto grid = convert(args, in, options, stats);

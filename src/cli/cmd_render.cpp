@@ -108,8 +108,9 @@ int runRender(const Argv& argv) {
     const std::string output = args.require("-o");
     RenderSettings settings = settingsFromFlags(args);
     checkImagePath(output);
+    checkNotAnInput(output, input, "-o");
     const auto statsPath = args.get("--stats");
-    if (statsPath) checkStatsPath(*statsPath, output);
+    if (statsPath) checkStatsPath(*statsPath, output), checkNotAnInput(*statsPath, input, "--stats");
 
     InterruptGuard guard;  // before loading: a Ctrl-C then stops the render before it starts
     std::unique_ptr<tbb::global_control> threads;
