@@ -73,6 +73,9 @@ struct StreamOptions {
     /// Voxels whose projected spacing h·f/z is under this many pixels are drawn as points by
     /// the renderer (hybrid: its threshold τ; point mode: +∞; splat mode: 0, no aggregates).
     double pointBelowPx = 0.0;
+    /// Whole-leaf aggregates (8³ cells) through the vectorised sums (volume/leaf_moments.h);
+    /// false: the scalar row sums they are tested against (same moments to float rounding).
+    bool vectorLeafMoments = true;
 };
 
 /// @brief Counts of what the stream released and what it culled, by cause.
