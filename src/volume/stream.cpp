@@ -315,10 +315,11 @@ void VoxelStream::extractAggregates(const Block& b, VoxelBatch& out) const {
                 cov[0][1] = cov[1][0] = a.xy * im - mu.x * mu.y;
                 cov[0][2] = cov[2][0] = a.xz * im - mu.x * mu.z;
                 cov[1][2] = cov[2][1] = a.yz * im - mu.y * mu.z;
-                const glm::dmat3 covView = toView * cov * glm::transpose(toView);
-                // Projected (Jacobian of the perspective map at μ, EWA 2001 eq. 25): J = f/z [I | −v.xy/z].
+                // Projected (Jacobian of the perspective map at μ, EWA 2001 eq. 25): J = f/z [I | −v.xy/z];
+                // the spread is trace(J A Σ Aᵀ Jᵀ)/2 = Σ over the rows j of J of (Aᵀj)ᵀ Σ (Aᵀj).
                 const glm::dvec3 jx(f / v.z, 0.0, -f * v.x / (v.z * v.z)), jy(0.0, f / v.z, -f * v.y / (v.z * v.z));
-                const double spread = 0.5 * (glm::dot(jx, covView * jx) + glm::dot(jy, covView * jy));
+                const glm::dvec3 ux = jx * toView, uy = jy * toView;  // row vector · A = Aᵀj
+                const double spread = 0.5 * (glm::dot(ux, cov * ux) + glm::dot(uy, cov * uy));
                 out.viewPos.emplace_back(v);
                 out.distance.push_back(float(glm::length(v)));
                 out.sigma.push_back(a.m);
