@@ -116,9 +116,11 @@ ActiveRegions::ActiveRegions(const openvdb::FloatGrid& grid) {
 }
 
 RayIntegrator::RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions,
-                             const ShadingField* shading)
+                             const ShadingField* shading, const EmissionSource* emission)
     : volume_(volume), table_(table), accessor_(volume.grid->getConstAccessor()),
       shading_(shading ? std::make_unique<ShadingField::Accessor>(shading->tree()) : nullptr),
+      emission_(emission),
+      emissionAccessor_(emission ? std::make_unique<EmissionSource::Accessor>(emission->accessor()) : nullptr),
       bins_(kRingSize),
       ownRegions_(regions ? nullptr : std::make_unique<ActiveRegions>(*volume.grid)),
       regions_(regions ? regions : ownRegions_.get()) {}
@@ -228,8 +230,9 @@ void RayIntegrator::gather(const glm::dvec3& o, const glm::dvec3& d, double tEnt
 }
 
 Classified RayIntegrator::classify(const openvdb::Coord& ijk, float value) {
-    const Classified cls = table_(value);
-    return shading_ ? applyShading(cls, shading_->getValue(ijk)) : cls;
+    Classified cls = table_(value);
+    if (shading_) cls = applyShading(cls, shading_->getValue(ijk));
+    return emission_ ? applyEmission(cls, emission_->at(*emissionAccessor_, ijk)) : cls;
 }
 
 namespace {
@@ -326,7 +329,8 @@ double RayIntegrator::opticalDepth(const glm::dvec3& origin, const glm::dvec3& d
 }
 
 Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
-                      RenderStats& stats, const ShadingField* shading, const RenderControl& control) {
+                      RenderStats& stats, const ShadingField* shading, const RenderControl& control,
+                      const EmissionSource* emission) {
     const auto start = std::chrono::steady_clock::now();
     const int n = std::max(1, int(std::ceil(std::sqrt(double(spp)) - 1e-9)));  // strata per axis
     stats.raysPerPixel = n * n;
@@ -358,7 +362,7 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
             return PixelCoord(px + (sx + hash01(px, py, 2 * s)) / n, py + (sy + hash01(px, py, 2 * s + 1)) / n);
         };
         tbb::parallel_for(tbb::blocked_range<int>(0, sh, 1), [&](const tbb::blocked_range<int>& rows) {
-            RayIntegrator integrator(volume, table, &regions, shading);
+            RayIntegrator integrator(volume, table, &regions, shading, emission);
             for (int r = rows.begin(); r < rows.end(); ++r) {
                 if (stopped.load(std::memory_order_relaxed) || (control.stop && control.stop())) {
                     stopped.store(true);

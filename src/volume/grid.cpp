@@ -115,6 +115,17 @@ void sanitizeValues(Volume& v) {
 
 }  // namespace
 
+std::string transformProblem(const openvdb::math::Transform& transform) {
+    try {
+        double voxelSize = 0.0;
+        linearUniformMap(transform, "transform", voxelSize);
+        return "";
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        return what.rfind("transform: ", 0) == 0 ? what.substr(11) : what;
+    }
+}
+
 void initOpenVdb() {
     static std::once_flag once;
     std::call_once(once, [] {
@@ -236,14 +247,17 @@ Volume loadVolume(const std::string& path, const std::string& gridName) {
     return v;
 }
 
-void writeVolume(const std::string& path, openvdb::FloatGrid::Ptr grid) {
+void writeVolume(const std::string& path, openvdb::FloatGrid::Ptr grid) { writeVolumes(path, {std::move(grid)}); }
+
+void writeVolumes(const std::string& path, const std::vector<openvdb::FloatGrid::Ptr>& grids) {
     initOpenVdb();
     checkRegularOutputPath(path);
     const std::string target = resolveOutputPath(path);  // through a symbolic link, never replacing it
     const std::string tmp = temporaryPathFor(target);
     try {
         openvdb::io::File file(tmp);
-        file.write({grid});
+        openvdb::GridCPtrVec all(grids.begin(), grids.end());
+        file.write(all);
         file.close();
     } catch (const std::exception& e) {
         std::remove(tmp.c_str());

@@ -7,10 +7,13 @@
 #include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace vdbsplat {
+
+struct EmissionGrid;  // volume/emission.h
 
 /// @brief One scalar grid ready to render.
 struct Volume {
@@ -24,6 +27,8 @@ struct Volume {
     uint64_t activeVoxels = 0;      ///< active voxel count (active tiles counted as their voxels)
     uint64_t nonFiniteCount = 0;    ///< active voxels whose NaN/inf value was replaced by 0
     float valueMin = 0.f, valueMax = 1.f;  ///< range of finite active values
+    /// An emission grid sharing this grid's kernels (volume/emission.h: attachEmission); null: none.
+    std::shared_ptr<const EmissionGrid> emission;
 
     /// @brief World-space bounds of the active voxels' centres, widened by half a voxel.
     void worldBounds(glm::dvec3& lo, glm::dvec3& hi) const;
@@ -41,6 +46,10 @@ Volume loadVolume(const std::string& path, const std::string& gridName = "");
 /// @brief Wraps an in-memory float grid (tests, generators) as a Volume, validating it as loadVolume does.
 Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label = "<memory>");
 
+/// @brief Empty when vdbsplat can render a grid with transform @p transform, else the reason
+/// (the check loadVolume applies; `vdbsplat info` reports it).
+std::string transformProblem(const openvdb::math::Transform& transform);
+
 /// @brief A human-readable description of every grid in @p path (`vdbsplat info`).
 /// @throw Error as loadVolume for unreadable files.
 std::string describeFile(const std::string& path);
@@ -48,5 +57,8 @@ std::string describeFile(const std::string& path);
 /// @brief Writes @p grid to @p path atomically (temporary file, then rename).
 /// @throw Error naming the path on failure.
 void writeVolume(const std::string& path, openvdb::FloatGrid::Ptr grid);
+
+/// @brief Writes several grids (e.g. density and temperature) to one file, as writeVolume.
+void writeVolumes(const std::string& path, const std::vector<openvdb::FloatGrid::Ptr>& grids);
 
 }  // namespace vdbsplat

@@ -13,6 +13,7 @@
 #include "pointfilter/point_filter.h"
 #include "shading/shading_field.h"
 #include "util/error.h"
+#include "volume/emission.h"
 
 namespace vdbsplat {
 
@@ -45,8 +46,8 @@ void VoxelBatch::clear() {
 }
 
 VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
-                         const StreamOptions& options, const VoxelShader* shader)
-    : volume_(volume), camera_(camera), table_(table), options_(options), shader_(shader),
+                         const StreamOptions& options, const VoxelShader* shader, const EmissionSource* emission)
+    : volume_(volume), camera_(camera), table_(table), options_(options), shader_(shader), emission_(emission),
       slabLength_(options.slabThickness * volume.voxelSize), slabsPerWindow_(std::max(1, options.slabsPerWindow)) {
     if (volume.activeVoxels > kMaxActiveVoxels)
         throw Error(volume.file + ": grid '" + volume.name + "' has " + std::to_string(volume.activeVoxels) +
@@ -181,11 +182,15 @@ template <typename Fn>
 void VoxelStream::forEachActive(const Block& b, Fn&& fn) const {
     std::optional<VoxelShader::Accessor> acc;
     if (shader_) acc.emplace(volume_.grid->tree());  // per block: blocks run on any thread
+    std::optional<EmissionSource::Accessor> emissionAcc;
+    if (emission_) emissionAcc.emplace(emission_->accessor());
     const auto classify = [&](openvdb::Index n, float value) {
-        const Classified cls = table_(value);
-        if (!shader_ || !(cls.sigma > 0.f)) return cls;
+        Classified cls = table_(value);
+        if (!shader_ && !emission_) return cls;
         const openvdb::Coord ijk = b.origin.offsetBy(int(n >> 6), int((n >> 3) & 7), int(n & 7));
-        return applyShading(cls, (*shader_)(*acc, b.leaf, n, ijk, value));
+        if (shader_ && cls.sigma > 0.f) cls = applyShading(cls, (*shader_)(*acc, b.leaf, n, ijk, value));
+        // Emission after shading: emitted light is not lit (docs/emission.md).
+        return emission_ ? applyEmission(cls, emission_->at(*emissionAcc, ijk)) : cls;
     };
     if (b.leaf) {
         const float* values = b.leaf->buffer().data();

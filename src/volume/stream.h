@@ -27,7 +27,8 @@
 
 namespace vdbsplat {
 
-class VoxelShader;  // shading/shading_field.h
+class VoxelShader;     // shading/shading_field.h
+class EmissionSource;  // volume/emission.h
 
 /// @brief One depth window of voxels, structure of arrays, in a deterministic order.
 struct VoxelBatch {
@@ -88,8 +89,10 @@ public:
     /// @brief Streams @p volume for @p camera; @p table classifies values.
     /// @throw Error when the grid is too large to stream (more than 2^32 active voxels).
     /// @p shader: shades each voxel after classification (nullptr: unshaded; docs/shading.md).
+    /// @p emission: adds each voxel's emission after shading (nullptr: none; docs/emission.md).
     VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
-                const StreamOptions& options = {}, const VoxelShader* shader = nullptr);
+                const StreamOptions& options = {}, const VoxelShader* shader = nullptr,
+                const EmissionSource* emission = nullptr);
 
     /// @brief Fills @p batch with the next window front to back; false when the stream is done.
     /// @param hidden optional: returns true for a block whose screen rectangle (pixels,
@@ -128,6 +131,7 @@ private:
     const ClassificationTable& table_;
     StreamOptions options_;
     const VoxelShader* shader_;
+    const EmissionSource* emission_;
     double slabLength_;
     std::vector<Block> blocks_;   // sorted by dMin
     size_t nextBlock_ = 0;
