@@ -68,11 +68,18 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
                                  : settings.mode == RenderMode::Splat ? 0.0
                                                                       : pass.threshold;
     VoxelStream stream(volume, camera, table, streamOptions, shader, emission);
-    TileCompositor compositor(camera.width(), camera.height(), tables,
-                              ExactContext{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance});
-    const ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
-                                settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
-                                pass.prefilterVariance};
+    // The kernels' shape in view space (anisotropic or sheared voxels: ellipsoids).
+    // view = R·(world − eye), R's rows right, up, forward: M = R·A.
+    const glm::dmat3 worldToView = glm::transpose(glm::dmat3(camera.right(), camera.up(), camera.forward()));
+    KernelShape shape = KernelShape::of(worldToView * glm::dmat3(volume.indexToWorld));
+    shape.sphere = volume.isotropic;
+    ExactContext exact{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance};
+    exact.shape = &shape;
+    TileCompositor compositor(camera.width(), camera.height(), tables, exact);
+    ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
+                          settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
+                          pass.prefilterVariance};
+    ctx.shape = &shape;
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
     PrimitiveBuffer prims;

@@ -20,7 +20,12 @@ struct Volume {
     openvdb::FloatGrid::Ptr grid;   ///< values as float; non-finite values were set to 0 (see nonFiniteCount)
     std::string file;               ///< the file it came from ("" if generated in memory)
     std::string name;               ///< the grid's name
-    double voxelSize = 1.0;         ///< h, world units per voxel (uniform; non-uniform scale is refused)
+    /// h, world units per voxel: |det A|^(1/3) for the linear part A of indexToWorld (the edge
+    /// of the cube with the voxel's volume; the column length for cubic voxels).
+    double voxelSize = 1.0;
+    /// A is h·(rotation): cubic voxels, sphere kernels. False: anisotropic or sheared voxels,
+    /// ellipsoid kernels (footprint/ellipsoid.h).
+    bool isotropic = true;
     glm::dmat4 indexToWorld{1.0};   ///< affine map from index space (voxel centres at integers) to world
     glm::dmat4 worldToIndex{1.0};   ///< its inverse
     openvdb::CoordBBox indexBox;    ///< bounding box of the active voxels (inclusive)
@@ -40,7 +45,7 @@ void initOpenVdb();
 /// @brief Loads grid @p gridName (or, if empty, the first float/double scalar grid) from @p path.
 /// @throw Error naming the file and the problem: missing, not a VDB, truncated or corrupt,
 /// no float grid, no grid of that name, an empty grid, or a transform that is not linear
-/// with uniform scale.
+/// (frustum) or is singular. Any affine map is accepted (anisotropic voxels, rotation, shear).
 Volume loadVolume(const std::string& path, const std::string& gridName = "");
 
 /// @brief Wraps an in-memory float grid (tests, generators) as a Volume, validating it as loadVolume does.

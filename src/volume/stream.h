@@ -141,6 +141,11 @@ private:
     int64_t nextSlab_ = 0;
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
     glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)
+    // The voxel's shape in world units (volume/grid.h: any affine map): the largest semi-axis
+    // per index unit (the kernel's bounding sphere is R·this) and the half-diagonal of a block's
+    // voxel centres (bounds the block's distance range). For cubic voxels h and 3.5√3·h.
+    double largestAxis_ = 1.0;
+    double blockHalfDiagonal_ = 0.0;
     StreamCounts counts_;
     uint64_t windows_ = 0;
     size_t largest_ = 0;
