@@ -117,13 +117,14 @@ std::vector<AffineCase> affineCases() {
 
 // The bar: hybrid against the reference at the three standard views for a grid of
 // voxel size 1,1,2.5 (as `convert --spacing 1,1,2.5` writes), a rotated one and a sheared one
-// (Marschner–Lobb 41³, grey, 96², 9 rays per pixel). Floors from the measured values (printed).
+// (Marschner–Lobb 41³, grey, 96², 9 rays per pixel). Measured (printed): far 48.7 / 47.3 / 43.7,
+// framed 56.4 / 52.2 / 46.0, close 59.5 / 54.1 / 59.7 dB for the three maps; floors 40, 43, 50 dB.
 TEST(Affine, AnisotropicAndRotatedGridsMatchTheReference) {
     const TransferFunction tf = TransferFunction::preset("grey");
     for (const AffineCase& c : affineCases()) {
         const Volume v = withTransform(marschnerLobbGrid()->deepCopy(), c.A, c.t);
         ASSERT_FALSE(v.isotropic) << c.name;
-        for (const auto& [distance, floor] : {std::pair{8.0, 34.0}, std::pair{1.0, 40.0}, std::pair{0.35, 40.0}}) {
+        for (const auto& [distance, floor] : {std::pair{8.0, 40.0}, std::pair{1.0, 43.0}, std::pair{0.35, 50.0}}) {
             RenderStats stats;
             const Image ref = render(v, tf, settingsFor(RenderMode::Reference, distance), stats);
             const double hybrid = psnr(v, tf, settingsFor(RenderMode::Hybrid, distance), ref);
