@@ -62,7 +62,9 @@ TEST(Ellipsoid, ConicMatchesBruteForceRays) {
                     inside += hit;
                     ASSERT_EQ(i2 <= 1.0, hit) << "conic at " << x << "," << y << " i2 " << i2;
                     ASSERT_EQ(d2 <= 1.0, hit) << "distance at " << x << "," << y << " d2 " << d2;
-                    if (hit) ASSERT_TRUE(b.lo.x <= x && x <= b.hi.x && b.lo.y <= y && y <= b.hi.y) << "outside bounds";
+                    if (hit) {
+                        ASSERT_TRUE(b.lo.x <= x && x <= b.hi.x && b.lo.y <= y && y <= b.hi.y) << "outside bounds";
+                    }
                 }
         }
     }
@@ -100,7 +102,9 @@ TEST(Ellipsoid, SphereShapeGivesDesignEllipse) {
             EXPECT_NEAR(e.ellipse.b, s.b, 1e-7 * s.a);
             EXPECT_NEAR(e.ellipse.centre.x, s.centre.x, 1e-7 * s.a);
             EXPECT_NEAR(e.ellipse.centre.y, s.centre.y, 1e-7 * s.a);
-            if (s.rho > 1e-9) EXPECT_NEAR(std::abs(glm::dot(e.ellipse.u, s.u)), 1.0, 1e-9);
+            if (s.rho > 1e-9) {
+                EXPECT_NEAR(std::abs(glm::dot(e.ellipse.u, s.u)), 1.0, 1e-9);
+            }
             EXPECT_NEAR(e.lengthScale, h, 1e-12);
         }
     }

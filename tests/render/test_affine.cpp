@@ -97,7 +97,9 @@ TEST(Affine, StretchedVoxelSplatKeepsThePointEnergy) {
         std::printf("  stretched voxel %-9s at %5.1f: total %.6g, point rule %.6g (ratio %.5f)\n",
                     toString(mode).c_str(), distance, alpha, want, alpha / want);
         EXPECT_NEAR(alpha / want, 1.0, tolerance) << toString(mode);
-        if (mode == RenderMode::Splat) EXPECT_GT(stats.splats, 0u);
+        if (mode == RenderMode::Splat) {
+            EXPECT_GT(stats.splats, 0u);
+        }
     }
 }
 
