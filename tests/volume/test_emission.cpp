@@ -13,12 +13,12 @@ namespace vdbsplat {
 namespace {
 
 // The sRGB white point is D65, a daylight spectrum close to a 6504 K blackbody: their linear
-// sRGB agree to a few percent (the Planckian locus passes just beside D65).
+// sRGB agree within 5 % (measured 1.042, 0.984, 1.035: the Planckian locus passes just beside D65).
 TEST(Emission, BlackbodyNearD65IsAboutWhite) {
     const glm::vec3 c = blackbodyRgb(6504.0);
-    EXPECT_NEAR(c.x, 1.0, 0.08);
-    EXPECT_NEAR(c.y, 1.0, 0.08);
-    EXPECT_NEAR(c.z, 1.0, 0.08);
+    EXPECT_NEAR(c.x, 1.0, 0.05);
+    EXPECT_NEAR(c.y, 1.0, 0.05);
+    EXPECT_NEAR(c.z, 1.0, 0.05);
     // Luminance 1 (Y = 0.2126 R + 0.7152 G + 0.0722 B) where no channel is clipped.
     EXPECT_NEAR(0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z, 1.0, 2e-3);
 }
