@@ -426,6 +426,19 @@ void TileCompositor::drawSplatTables(const TileRecord& p, const ExactIndexMap& m
 
 void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
     const Camera& camera = *exact_.camera;
+    if (exact_.shape && !exact_.shape->sphere) {  // an ellipsoid at the eye: the exact half-ray integral
+        const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
+        const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
+        const glm::dvec3 c(p.viewPos);
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                const int i = px.local(x, y);
+                if (!px.live(i)) continue;
+                const double tau = p.sigma * ellipsoidHalfRayDeposit(*exact_.shape, c, camera.viewRay(PixelCoord(x + 0.5, y + 0.5)));
+                if (tau > 0.0) px.over(i, float(tau), p.color);
+            }
+        return;
+    }
     const double h = exact_.voxelSize;
     const SphereProjection sphere = projectSphere(camera, ViewPoint(p.viewPos), Kernel::kRadius * h);
     // Recomputed from the float view position: a borderline sphere may no longer be an

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "footprint/ellipse.h"
+#include "footprint/ellipsoid.h"
 #include "footprint/kernel.h"
 #include "footprint/screen_kernel.h"
 #include "pointfilter/point_filter.h"
@@ -80,15 +81,56 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
     return p;
 }
 
+/// An ellipsoid kernel (footprint/ellipsoid.h): its exact silhouette widened by the low-pass,
+/// and the exact index-space ray–centre distance per pixel (an ExactIndexMap in index space),
+/// read by the compositor's exact-index path. τ = σ_world·L·F(d), L the world length per index
+/// length, taken along the centre ray (it varies by ~(anisotropy)·α over the footprint;
+/// docs/kernel.md, "Any voxel shape"); kernels at the eye take the exact half-ray integral.
+Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, const ProjectionContext& ctx) {
+    Primitive p;
+    const KernelShape& shape = *ctx.shape;
+    const EllipsoidProjection e = projectEllipsoid(shape, c, ctx.camera.focal(), ctx.camera.principal());
+    p.viewPos = glm::vec3(c);
+    p.sigma = sigma;
+    switch (e.kind) {
+        case SphereClass::Behind: return p;
+        case SphereClass::EyeInside:
+        case SphereClass::Straddles:
+            p.kind = PrimitiveKind::NearEye;
+            p.range = pixelRange(e.ellipse.bounds, ctx.camera.width(), ctx.camera.height());
+            break;
+        case SphereClass::Ellipse: {
+            const ScreenKernel kernel = makeScreenKernel(e.ellipse, ctx.prefilterVariance);
+            p.kind = PrimitiveKind::SplatExactIndex;
+            p.centre = glm::vec2(kernel.centre);
+            p.conic = glm::vec3(kernel.conic[0][0], kernel.conic[0][1], kernel.conic[1][1]);
+            p.scale = float(sigma / ctx.voxelSize * e.lengthScale * kernel.amplitude);  // σ_world·L·amplitude
+            p.sin2Alpha = float(e.ellipse.sinAlpha * e.ellipse.sinAlpha);
+            p.exactMap = makeEllipsoidIndexMap(kernel, e, shape, PixelCoord(p.centre));
+            p.hasExactMap = true;
+            p.range = pixelRange(kernel.bounds, ctx.camera.width(), ctx.camera.height());
+            break;
+        }
+    }
+    if (p.range.empty()) p.kind = PrimitiveKind::Culled;
+    return p;
+}
+
 }  // namespace
 
 Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx,
                        float spreadPx2) {
-    const double spacingPx = c.z > 0.0 ? ctx.voxelSize * ctx.camera.focal() / c.z : INFINITY;
+    const bool ellipsoid = ctx.shape && !ctx.shape->sphere;
+    // The projected voxel spacing h·f/z; for an ellipsoid its longest axis (a splat as soon as any
+    // axis is magnified) decides, and its projected spacing sets the point filter.
+    const double spacingPx = c.z > 0.0 ? (ellipsoid ? ctx.shape->sMax : ctx.voxelSize) * ctx.camera.focal() / c.z : INFINITY;
     const bool point = ctx.mode == RenderMode::Point ? c.z > 0.0
                        : ctx.mode == RenderMode::Splat ? false
                                                        : spacingPx < ctx.threshold;
-    Primitive p = point ? makePoint(c, sigma, spacingPx, spreadPx2, ctx) : makeSplat(c, sigma, ctx);
+    const double filterPx = ellipsoid && c.z > 0.0 ? ctx.shape->projectedSpacing() * ctx.camera.focal() / c.z : spacingPx;
+    Primitive p = point       ? makePoint(c, sigma, filterPx, spreadPx2, ctx)
+                  : ellipsoid ? makeEllipsoidSplat(c, sigma, ctx)
+                              : makeSplat(c, sigma, ctx);
     p.color = (!point && ctx.showPrimitives) ? splatTint(color) : color;
     return p;
 }

@@ -9,11 +9,13 @@
 #include <cmath>
 #include <optional>
 
+#include "footprint/ellipsoid.h"
 #include "footprint/kernel.h"
 #include "pointfilter/point_filter.h"
 #include "shading/shading_field.h"
 #include "volume/leaf_moments.h"
 #include "util/error.h"
+#include "volume/emission.h"
 
 namespace vdbsplat {
 
@@ -41,8 +43,8 @@ void VoxelBatch::clear() {
 }
 
 VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
-                         const StreamOptions& options, const VoxelShader* shader)
-    : volume_(volume), camera_(camera), table_(table), options_(options), shader_(shader),
+                         const StreamOptions& options, const VoxelShader* shader, const EmissionSource* emission)
+    : volume_(volume), camera_(camera), table_(table), options_(options), shader_(shader), emission_(emission),
       slabLength_(options.slabThickness * volume.voxelSize), slabsPerWindow_(std::max(1, options.slabsPerWindow)) {
     if (volume.activeVoxels > kMaxActiveVoxels)
         throw Error(volume.file + ": grid '" + volume.name + "' has " + std::to_string(volume.activeVoxels) +
@@ -57,6 +59,14 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
     }
     worldToView[3] = glm::dvec4(-glm::dot(r, camera_.eye()), -glm::dot(u, camera_.eye()), -glm::dot(f, camera_.eye()), 1.0);
     indexToView_ = worldToView * volume_.indexToWorld;
+    // Any affine voxel (volume/grid.h): the block's half-diagonal is the longest of A·(±1, ±1, ±1)
+    // times 3.5, the kernel's reach R times A's largest singular value. Cubes: 3.5√3·h and R·h.
+    const glm::dmat3 A(volume_.indexToWorld);
+    double diagonal = 0.0;
+    for (int s = 0; s < 4; ++s)
+        diagonal = std::max(diagonal, glm::length(A * glm::dvec3(1.0, s & 1 ? -1.0 : 1.0, s & 2 ? -1.0 : 1.0)));
+    blockHalfDiagonal_ = 0.5 * (kBlockDim - 1) * (volume_.isotropic ? std::sqrt(3.0) * volume_.voxelSize : diagonal);
+    largestAxis_ = volume_.isotropic ? volume_.voxelSize : singularValues(A).x;
     collectBlocks();
 }
 
@@ -80,8 +90,7 @@ void VoxelStream::collectBlocks() {
                                    uint32_t(kBlockDim * kBlockDim * kBlockDim), 0});
     }
     // Distance bounds of voxel centres: the block's bounding sphere around its centre.
-    const double h = volume_.voxelSize;
-    const double halfDiagonal = 0.5 * (kBlockDim - 1) * std::sqrt(3.0) * h;
+    const double halfDiagonal = blockHalfDiagonal_;
     for (Block& b : all) {
         const glm::dvec3 centreIdx = glm::dvec3(b.origin.x(), b.origin.y(), b.origin.z()) + 0.5 * (b.dim - 1);
         const glm::dvec3 centre(volume_.indexToWorld * glm::dvec4(centreIdx, 1.0));
@@ -106,10 +115,9 @@ void VoxelStream::collectBlocks() {
 }
 
 bool VoxelStream::visible(const Block& b) const {
-    const double h = volume_.voxelSize;
     const glm::dvec3 centreIdx = glm::dvec3(b.origin.x(), b.origin.y(), b.origin.z()) + 0.5 * (b.dim - 1);
     const glm::dvec3 c = camera_.toView(glm::dvec3(volume_.indexToWorld * glm::dvec4(centreIdx, 1.0)));
-    const double radius = (0.5 * (b.dim - 1) * std::sqrt(3.0) + Kernel::kRadius) * h;
+    const double radius = blockHalfDiagonal_ + Kernel::kRadius * largestAxis_;
     if (c.z < -radius) return false;  // entirely behind the eye
     // Side planes of the frustum widened by the screen margin, x = z·t for the slopes t of the
     // image's edges (the principal point need not be centred: a cropped camera).
@@ -150,12 +158,12 @@ void VoxelStream::screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1)
 
 int VoxelStream::lodLevel(const Block& b) const {
     if (!(options_.lodCellPx > 0.0) || !(options_.pointBelowPx > 0.0)) return 0;
-    const double h = volume_.voxelSize;
     const glm::dvec3 centreIdx = glm::dvec3(b.origin.x(), b.origin.y(), b.origin.z()) + 0.5 * (b.dim - 1);
     const glm::dvec3 c(indexToView_ * glm::dvec4(centreIdx, 1.0));
-    const double zNear = c.z - 0.5 * (b.dim - 1) * std::sqrt(3.0) * h;  // nearest voxel centre's depth, bounded
+    const double zNear = c.z - blockHalfDiagonal_;  // nearest voxel centre's depth, bounded
     if (!(zNear > 0.0)) return 0;
-    const double spacingPx = h * camera_.focal() / zNear;  // the block's largest projected voxel spacing
+    // The block's largest projected voxel spacing (the longest voxel axis: as the projection decides).
+    const double spacingPx = largestAxis_ * camera_.focal() / zNear;
     if (!(spacingPx < options_.pointBelowPx)) return 0;     // some voxel may be a splat
     // A cell of n = 2^L voxels per side, uniform, adds the spread s²·(n² − 1)/12 px² per axis
     // (s the projected spacing): at most kLodMaxSpreadRatio of the points' own filter variance.
@@ -177,11 +185,15 @@ template <typename Fn>
 void VoxelStream::forEachActive(const Block& b, Fn&& fn) const {
     std::optional<VoxelShader::Accessor> acc;
     if (shader_) acc.emplace(volume_.grid->tree());  // per block: blocks run on any thread
+    std::optional<EmissionSource::Accessor> emissionAcc;
+    if (emission_) emissionAcc.emplace(emission_->accessor());
     const auto classify = [&](openvdb::Index n, float value) {
-        const Classified cls = table_(value);
-        if (!shader_ || !(cls.sigma > 0.f)) return cls;
+        Classified cls = table_(value);
+        if (!shader_ && !emission_) return cls;
         const openvdb::Coord ijk = b.origin.offsetBy(int(n >> 6), int((n >> 3) & 7), int(n & 7));
-        return applyShading(cls, (*shader_)(*acc, b.leaf, n, ijk, value));
+        if (shader_ && cls.sigma > 0.f) cls = applyShading(cls, (*shader_)(*acc, b.leaf, n, ijk, value));
+        // Emission after shading: emitted light is not lit (docs/emission.md).
+        return emission_ ? applyEmission(cls, emission_->at(*emissionAcc, ijk)) : cls;
     };
     if (b.leaf) {
         const float* values = b.leaf->buffer().data();

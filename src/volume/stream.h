@@ -27,7 +27,8 @@
 
 namespace vdbsplat {
 
-class VoxelShader;  // shading/shading_field.h
+class VoxelShader;     // shading/shading_field.h
+class EmissionSource;  // volume/emission.h
 
 /// @brief One depth window of voxels, structure of arrays, in a deterministic order.
 struct VoxelBatch {
@@ -91,8 +92,10 @@ public:
     /// @brief Streams @p volume for @p camera; @p table classifies values.
     /// @throw Error when the grid is too large to stream (more than 2^32 active voxels).
     /// @p shader: shades each voxel after classification (nullptr: unshaded; docs/shading.md).
+    /// @p emission: adds each voxel's emission after shading (nullptr: none; docs/emission.md).
     VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
-                const StreamOptions& options = {}, const VoxelShader* shader = nullptr);
+                const StreamOptions& options = {}, const VoxelShader* shader = nullptr,
+                const EmissionSource* emission = nullptr);
 
     /// @brief Fills @p batch with the next window front to back; false when the stream is done.
     /// @param hidden optional: returns true for a block whose screen rectangle (pixels,
@@ -132,6 +135,7 @@ private:
     const ClassificationTable& table_;
     StreamOptions options_;
     const VoxelShader* shader_;
+    const EmissionSource* emission_;
     double slabLength_;
     std::vector<Block> blocks_;   // sorted by dMin
     size_t nextBlock_ = 0;
@@ -142,6 +146,11 @@ private:
     int64_t nextSlab_ = 0;
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
     glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)
+    // The voxel's shape in world units (volume/grid.h: any affine map): the largest semi-axis
+    // per index unit (the kernel's bounding sphere is R·this) and the half-diagonal of a block's
+    // voxel centres (bounds the block's distance range). For cubic voxels h and 3.5√3·h.
+    double largestAxis_ = 1.0;
+    double blockHalfDiagonal_ = 0.0;
     StreamCounts counts_;
     uint64_t windows_ = 0;
     size_t largest_ = 0;
