@@ -51,7 +51,7 @@ const char* kHelp =
     "  --runs N             timed runs per view and mode, 1..1000 (default 5)\n"
     "  --warmup N           untimed rounds before them, 0..100 (default 1)\n"
     "  --threads N          worker threads (default: all cores)\n"
-    "  --modes LIST         comma-separated, from hybrid, splat, point, reference\n"
+    "  --modes LIST         comma-separated, from hybrid, splat, point, ewa, swan, none, reference\n"
     "                       (default hybrid,splat,point; reference is slow)\n"
     "  --distances LIST     comma-separated framing distances (default 8,1,0.35)\n"
     "  --view-dir X,Y,Z     framing direction, centre to eye (default 0.9,-1.3,0.75)\n"
@@ -89,11 +89,11 @@ std::vector<RenderMode> parseModes(const std::string& text) {
     std::vector<RenderMode> modes;
     for (const std::string& item : splitList(text, "--modes")) {
         RenderMode mode;
-        if (item == "hybrid") mode = RenderMode::Hybrid;
-        else if (item == "splat") mode = RenderMode::Splat;
-        else if (item == "point") mode = RenderMode::Point;
-        else if (item == "reference") mode = RenderMode::Reference;
-        else throw Error("--modes: unknown mode '" + item + "' (choose hybrid, splat, point, reference)");
+        try {
+            mode = parseRenderMode(item);
+        } catch (const Error&) {
+            throw Error("--modes: unknown mode '" + item + "' (choose " + kRenderModeNames + ")");
+        }
         if (std::find(modes.begin(), modes.end(), mode) != modes.end())
             throw Error("--modes: '" + item + "' given more than once");
         modes.push_back(mode);

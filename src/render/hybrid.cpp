@@ -64,9 +64,9 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     StreamOptions streamOptions = settings.stream;
     streamOptions.lodCellPx = pass.lodPx;
     streamOptions.pointPrefilterVariance = pass.prefilterVariance;
-    streamOptions.pointBelowPx = settings.mode == RenderMode::Point   ? INFINITY
-                                 : settings.mode == RenderMode::Splat ? 0.0
-                                                                      : pass.threshold;
+    streamOptions.pointBelowPx = settings.mode == RenderMode::Point ? INFINITY
+                                 : drawsOnlySplats(settings.mode)   ? 0.0
+                                                                    : pass.threshold;
     VoxelStream stream(volume, camera, table, streamOptions, shader);
     TileCompositor compositor(camera.width(), camera.height(), tables,
                               ExactContext{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance});
@@ -161,8 +161,11 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     // Fixed costs follow the pixels the volume covers, not the image: the compositor, its
     // tiles and the postfilter see only that rectangle (a cropped camera: the same rays, so the
     // same image there, up to the float rounding of pixel coordinates); the rest is empty.
-    if (settings.filterOrder == FilterOrder::Prefilter) {
-        const ForwardPass pass{settings.threshold, settings.lodPx, kPrefilterVariance};
+    // Ewa and Swan fold V_h into each primitive by definition (the prefilter order); None has no
+    // low-pass at all, and no level of detail (an aggregate is a prefiltered point).
+    if (settings.filterOrder == FilterOrder::Prefilter || modeFixesFilterOrder(settings.mode)) {
+        const bool none = settings.mode == RenderMode::None;
+        const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, none ? 0.0 : kPrefilterVariance};
         const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance), 0);
         if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control);
         const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;

@@ -10,6 +10,7 @@
 #include "footprint/kernel.h"
 #include "footprint/screen_kernel.h"
 #include "pointfilter/point_filter.h"
+#include "render/project_modes.h"
 
 namespace vdbsplat {
 
@@ -38,7 +39,7 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float sp
     return p;
 }
 
-Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& ctx) {
+Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, const ProjectionContext& ctx) {
     Primitive p;
     const double h = ctx.voxelSize;
     const SphereProjection sphere = projectSphere(ctx.camera, c, Kernel::kRadius * h);
@@ -52,8 +53,13 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
             p.range = pixelRange(sphere.bounds, ctx.camera.width(), ctx.camera.height());
             break;
         case SphereClass::Ellipse: {
-            const ScreenKernel kernel = makeScreenKernel(sphere, ctx.prefilterVariance);
-            p.kind = ctx.footprint == FootprintPath::Exact ? PrimitiveKind::SplatExact
+            if (ctx.mode == RenderMode::Ewa) {  // Zwicker et al. 2001: the affine kernel (project_modes.h)
+                fillEwaSplat(p, c, sigma, ctx);
+                break;
+            }
+            const ScreenKernel kernel = splatKernelFor(sphere, spacingPx, ctx);  // Swan's stretch or V + V_h
+            p.kind = keepsTablePath(spacingPx, ctx)            ? PrimitiveKind::Splat
+                     : ctx.footprint == FootprintPath::Exact ? PrimitiveKind::SplatExact
                      : ctx.footprint == FootprintPath::Auto && sphere.affineIndexError() > kAutoExactIndexError
                          ? PrimitiveKind::SplatExactIndex
                          : PrimitiveKind::Splat;
@@ -78,10 +84,13 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
 Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx,
                        float spreadPx2) {
     const double spacingPx = c.z > 0.0 ? ctx.voxelSize * ctx.camera.focal() / c.z : INFINITY;
+    // Hybrid and None switch on the threshold; Splat, Ewa and Swan draw every voxel as a splat.
     const bool point = ctx.mode == RenderMode::Point ? c.z > 0.0
-                       : ctx.mode == RenderMode::Splat ? false
-                                                       : spacingPx < ctx.threshold;
-    Primitive p = point ? makePoint(c, sigma, spacingPx, spreadPx2, ctx) : makeSplat(c, sigma, ctx);
+                       : drawsOnlySplats(ctx.mode) ? false
+                                                   : spacingPx < ctx.threshold;
+    Primitive p = point ? makePoint(c, sigma, spacingPx, spreadPx2, ctx) : makeSplat(c, sigma, spacingPx, ctx);
+    if (point && ctx.mode == RenderMode::None && p.kind == PrimitiveKind::Point)
+        snapToNearestPixel(p, ctx.camera.width(), ctx.camera.height());
     p.color = (!point && ctx.showPrimitives) ? splatTint(color) : color;
     return p;
 }

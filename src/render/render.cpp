@@ -83,7 +83,10 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
         }
         case RenderMode::Hybrid:
         case RenderMode::Splat:
-        case RenderMode::Point: {
+        case RenderMode::Point:
+        case RenderMode::Ewa:
+        case RenderMode::Swan:
+        case RenderMode::None: {
             const Tables tables =
                 loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir));
             image = renderForward(volume, table, camera, tables, settings, stats, shader.get(), control);
