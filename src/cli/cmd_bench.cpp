@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "footprint/kernel.h"
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "cli/render_flags.h"
@@ -52,6 +53,7 @@ const char* kHelp =
     "  --warmup N           untimed rounds before them, 0..100 (default 1)\n"
     "  --threads N          worker threads (default: all cores)\n"
     "  --modes LIST         comma-separated, from hybrid, splat, point, ewa, swan, none, reference\n"
+    "  --kernel K           gaussian (default) | gaussian-sharp, as for render\n"
     "                       (default hybrid,splat,point; reference is slow)\n"
     "  --distances LIST     comma-separated framing distances (default 8,1,0.35)\n"
     "  --view-dir X,Y,Z     framing direction, centre to eye (default 0.9,-1.3,0.75)\n"
@@ -159,6 +161,7 @@ Options optionsFrom(const Args& args) {
         s.camera.up = {u[0], u[1], u[2]};
     }
     s.shading = shadingFromFlags(args);
+    if (auto v = args.get("--kernel")) s.kernel = KernelShape::named(*v).id();
     if (auto v = args.get("--runs")) o.runs = int(parseInt(*v, "--runs", 1, kMaxRuns));
     if (auto v = args.get("--warmup")) o.warmup = int(parseInt(*v, "--warmup", 0, kMaxWarmup));
     if (auto v = args.get("--modes")) o.modes = parseModes(*v);
@@ -216,7 +219,7 @@ std::string formatDistance(double d) {
 int runBench(const Argv& argv) {
     std::set<std::string> valueFlags{"--grid",      "--tf",  "--size", "--runs",      "--warmup", "--threads",
                                      "--modes",     "--distances", "--threshold", "--lod", "--simd",
-                                     "--footprint", "--filter-order", "--subpixels", "--json", "--view-dir", "--up"};
+                                     "--footprint", "--filter-order", "--subpixels", "--kernel", "--json", "--view-dir", "--up"};
     valueFlags.insert(shadingValueFlags().begin(), shadingValueFlags().end());
     const Args args(argv, valueFlags, {"-v"});
     if (args.wantsHelp()) {

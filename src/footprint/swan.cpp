@@ -9,17 +9,17 @@
 
 namespace vdbsplat {
 
-double swanStretch(const SphereProjection& e, double prefilterVariance) {
-    const double minorSigma = std::min(e.a, e.b) * Kernel::kSigma / Kernel::kRadius;  // px
+double swanStretch(const SphereProjection& e, double prefilterVariance, const KernelShape& kernel) {
+    const double minorSigma = std::min(e.a, e.b) * kernel.sigma() / kernel.radius();  // px
     const double filterSigma = std::sqrt(std::max(prefilterVariance, 0.0));
     return minorSigma > 0.0 ? std::max(1.0, filterSigma / minorSigma) : 1.0;
 }
 
-ScreenKernel makeSwanKernel(const SphereProjection& e, double prefilterVariance) {
+ScreenKernel makeSwanKernel(const SphereProjection& e, double prefilterVariance, const KernelShape& kernel) {
     if (!e.isEllipse())
         throw std::invalid_argument(std::string("makeSwanKernel: sphere is '") + sphereClassName(e.kind) +
                                     "', not an ellipse");
-    const double s = swanStretch(e, prefilterVariance);
+    const double s = swanStretch(e, prefilterVariance, kernel);
     ScreenKernel k = makeScreenKernel(e, 0.0);  // the exact ellipse, amplitude 1
     k.a *= s, k.b *= s;
     k.conic /= s * s;

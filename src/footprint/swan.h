@@ -20,9 +20,11 @@ namespace vdbsplat {
 /// @brief Swan's stretched kernel of the Ellipse @p e for the pixel filter variance
 /// @p prefilterVariance (px²): s = max(1, √V_h·R/(s_g·b)); with s = 1 the unfiltered ellipse.
 /// @throw std::invalid_argument when @p e is not an Ellipse.
-ScreenKernel makeSwanKernel(const SphereProjection& e, double prefilterVariance = kPrefilterVariance);
+ScreenKernel makeSwanKernel(const SphereProjection& e, double prefilterVariance = kPrefilterVariance,
+                            const KernelShape& kernel = KernelShape::standard());
 
 /// @brief The stretch factor s of makeSwanKernel (≥ 1).
-double swanStretch(const SphereProjection& e, double prefilterVariance = kPrefilterVariance);
+double swanStretch(const SphereProjection& e, double prefilterVariance = kPrefilterVariance,
+                   const KernelShape& kernel = KernelShape::standard());
 
 }  // namespace vdbsplat

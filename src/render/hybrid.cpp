@@ -112,8 +112,8 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
 /// How far (px) past the projection of a primitive's kernel sphere its deposits reach: a point's
 /// filter r_s ≤ kPointMaxRadiusPx (pointfilter/point_filter.h); a splat's support ellipse
 /// widened by V (screen_kernel.cpp: a' = √(a² + (R/s_g)²·V) ≤ a + (R/s_g)·√V); one pixel to spare.
-double depositReachPx(double prefilterVariance) {
-    return std::max(kPointMaxRadiusPx, Kernel::kRadius / Kernel::kSigma * std::sqrt(prefilterVariance)) + 1.0;
+double depositReachPx(double prefilterVariance, const KernelShape& kernel) {
+    return std::max(kPointMaxRadiusPx, kernel.radius() / kernel.sigma() * std::sqrt(prefilterVariance)) + 1.0;
 }
 
 /// The pixels of @p camera any primitive of @p volume can touch, grown by @p grow pixels: the
@@ -166,7 +166,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     if (settings.filterOrder == FilterOrder::Prefilter || modeFixesFilterOrder(settings.mode)) {
         const bool none = settings.mode == RenderMode::None;
         const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, none ? 0.0 : kPrefilterVariance};
-        const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance), 0);
+        const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, *tables.kernel), 0);
         if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control);
         const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
         const Image part = composite(volume, table, camera.cropped(crop->x0, crop->y0, w, h), tables, settings, pass,
@@ -184,7 +184,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     // pixels they reach through the filter lie within `border` more; the crop of the sub-pixel
     // image is that output rectangle with its own border, as subpixelCamera frames the whole image.
     const std::optional<PixelRange> crop =
-        coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance), grid.border);
+        coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, *tables.kernel), grid.border);
     if (!crop) {
         const Image sub = composite(volume, table, fine, tables, settings, pass, stats, shader, control);
         return postfilterImage(sub, grid, camera.width(), camera.height());

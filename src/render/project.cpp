@@ -28,7 +28,7 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float sp
     if (!std::isfinite(centre.x) || !std::isfinite(centre.y)) return p;
     p.kind = PrimitiveKind::Point;
     p.centre = glm::vec2(centre);
-    p.variance = float(pointFilterVariance(spacingPx, ctx.prefilterVariance) + spreadPx2);  // + an aggregate's spread (DESIGN §8.2)
+    p.variance = float(pointFilterVariance(spacingPx, ctx.prefilterVariance, ctx.tables.kernel->sigma()) + spreadPx2);  // + an aggregate's spread (DESIGN §8.2)
     // σ·M·(f/z)²·(D/z) with σ per world unit = sigma / h (DESIGN §4).
     p.total = float(pointDepositTotal(sigma / ctx.voxelSize, ctx.voxelSize, ctx.camera.focal(), c));
     PixelBox box;
@@ -42,7 +42,7 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float sp
 Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, const ProjectionContext& ctx) {
     Primitive p;
     const double h = ctx.voxelSize;
-    const SphereProjection sphere = projectSphere(ctx.camera, c, Kernel::kRadius * h);
+    const SphereProjection sphere = projectSphere(ctx.camera, c, ctx.tables.kernel->radius() * h);
     p.viewPos = glm::vec3(c);
     p.sigma = sigma;
     switch (sphere.kind) {

@@ -12,7 +12,8 @@ namespace vdbsplat {
 
 void fillEwaSplat(Primitive& p, const glm::dvec3& c, float sigma, const ProjectionContext& ctx) {
     const EwaKernel k =
-        makeEwaKernel(ctx.camera, c, ctx.voxelSize, Kernel::kSigma, Kernel::kRadius, ctx.prefilterVariance);
+        makeEwaKernel(ctx.camera, c, ctx.voxelSize, ctx.tables.kernel->sigma(), ctx.tables.kernel->radius(),
+                      ctx.prefilterVariance);
     if (!(k.amplitude > 0.0)) {
         p.kind = PrimitiveKind::Culled;
         return;
@@ -30,8 +31,8 @@ bool keepsTablePath(double spacingPx, const ProjectionContext& ctx) {
 }
 
 ScreenKernel splatKernelFor(const SphereProjection& sphere, double spacingPx, const ProjectionContext& ctx) {
-    if (keepsTablePath(spacingPx, ctx)) return makeSwanKernel(sphere, ctx.prefilterVariance);
-    return makeScreenKernel(sphere, ctx.prefilterVariance);
+    if (keepsTablePath(spacingPx, ctx)) return makeSwanKernel(sphere, ctx.prefilterVariance, *ctx.tables.kernel);
+    return makeScreenKernel(sphere, ctx.prefilterVariance, *ctx.tables.kernel);
 }
 
 void snapToNearestPixel(Primitive& p, int width, int height) {

@@ -78,7 +78,8 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
                 field = std::make_unique<ShadingField>(*shader);
                 stats.shadingSeconds = field->seconds();
             }
-            image = renderReference(volume, table, camera, settings.spp, stats, field.get(), control);
+            image = renderReference(volume, table, camera, settings.spp, stats, field.get(), control,
+                                    KernelShape::named(settings.kernel));
             break;
         }
         case RenderMode::Hybrid:
@@ -88,7 +89,8 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
         case RenderMode::Swan:
         case RenderMode::None: {
             const Tables tables =
-                loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir));
+                loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir),
+                                  KernelShape::named(settings.kernel));
             image = renderForward(volume, table, camera, tables, settings, stats, shader.get(), control);
             break;
         }

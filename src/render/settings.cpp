@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "footprint/kernel.h"
 #include "util/error.h"
 
 namespace vdbsplat {
@@ -57,6 +58,7 @@ void RenderSettings::validate() const {
     if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
         throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
     shading.validate();
+    (void)KernelShape::named(kernel);  // throws "--kernel: unknown kernel ..."
     if (!tablesDir.empty()) {
         std::error_code ec;
         if (!std::filesystem::is_directory(tablesDir, ec))
@@ -111,6 +113,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["spp"] = spp;
     j["threshold"] = threshold;
     j["footprint"] = toString(footprint);
+    j["kernel"] = kernel;
     // Ewa and Swan filter each primitive, None filters nothing (RenderMode): echo what was used.
     j["filter_order"] = mode == RenderMode::None ? "none" : modeFixesFilterOrder(mode) ? "prefilter" : toString(filterOrder);
     j["subpixels"] = modeFixesFilterOrder(mode) ? 1 : subpixels;

@@ -84,6 +84,8 @@ struct RenderSettings {
     int spp = 16;                           ///< reference: rays per pixel (rounded to a square)
     double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
     FootprintPath footprint = FootprintPath::Auto;
+    /// The reconstruction kernel (--kernel; KernelShape::named): every mode and the reference.
+    std::string kernel = "gaussian";
     FilterOrder filterOrder = FilterOrder::Postfilter;
     int subpixels = kDefaultSubpixels;      ///< Postfilter: sub-pixel grid per axis
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)

@@ -224,22 +224,27 @@ const Image& referenceAt(double distance) {
 
 double psnr(RenderMode mode, double distance, FilterOrder order = FilterOrder::Postfilter) {
     const double p = compareImages(renderOf(mode, distance, order), referenceAt(distance)).psnr;
-    std::printf("  checkerbox %-6s %-10s distance %-5g PSNR %6.2f dB\n", toString(mode).c_str(), toString(order).c_str(),
+    const std::string orderName = modeFixesFilterOrder(mode) ? "own filter" : toString(order);
+    std::printf("  checkerbox %-6s %-10s distance %-5g PSNR %6.2f dB\n", toString(mode).c_str(), orderName.c_str(),
                 distance, p);
     return p;
 }
 
-// The checker box far away: every voxel is far below a pixel, so without a low-pass (none) the
-// image aliases and falls well below hybrid, EWA and Swan, which all band-limit; framed, EWA is
-// within a fraction of a dB of hybrid in the same (prefilter) order.
-TEST(Modes, NoneAliasesFarAwayAndTheFilteredModesDoNot) {
-    const double hybridFar = psnr(RenderMode::Hybrid, 8.0, FilterOrder::Prefilter);
-    const double noneFar = psnr(RenderMode::None, 8.0), ewaFar = psnr(RenderMode::Ewa, 8.0), swanFar = psnr(RenderMode::Swan, 8.0);
-    EXPECT_LT(noneFar, hybridFar - 6.0);
-    EXPECT_GT(ewaFar, hybridFar - 1.0);
-    EXPECT_GT(swanFar, noneFar + 6.0);
-    const double hybridFramed = psnr(RenderMode::Hybrid, 1.0, FilterOrder::Prefilter);
-    EXPECT_NEAR(psnr(RenderMode::Ewa, 1.0), hybridFramed, 0.5);
+// The checker box at 96²: without a low-pass (none) the image aliases and falls below hybrid,
+// EWA and Swan, which all band-limit, far away and framed; EWA and Swan stay within a fraction of
+// a dB of hybrid in the same (prefilter) order. Measured (dB): far hybrid 33.72, ewa 33.85,
+// swan 33.90, none 32.14; framed hybrid 35.95, ewa 35.96, swan 35.99, none 26.95. Far away the
+// nearest-pixel points of a dense volume sum to a box filter per pixel, which aliases less than
+// point sampling would: the gap is smaller there (docs/modes.md).
+TEST(Modes, NoneAliasesAndTheFilteredModesDoNot) {
+    for (const double distance : {8.0, 1.0}) {
+        const double hybrid = psnr(RenderMode::Hybrid, distance, FilterOrder::Prefilter);
+        const double none = psnr(RenderMode::None, distance), ewa = psnr(RenderMode::Ewa, distance),
+                     swan = psnr(RenderMode::Swan, distance);
+        EXPECT_LT(none, hybrid - (distance > 1.0 ? 1.0 : 3.0)) << distance;
+        EXPECT_NEAR(ewa, hybrid, 0.5) << distance;
+        EXPECT_NEAR(swan, hybrid, 0.5) << distance;
+    }
 }
 
 }  // namespace
