@@ -31,7 +31,8 @@ Volume singleVoxel(double h) {
 }
 
 // Σ over a grid of parallel rays of the optical depth times each ray's area (voxel units) is the
-// kernel's mass σ·∫g dV = σ; along a ray at ρ the depth is σ·F(ρ) of that kernel, not the other's.
+// kernel's mass σ·∫g dV = σ; along a ray at ρ the depth is σ·F(ρ) of that kernel, not the other's,
+// both in opticalDepth (closed form) and in the image path's depth bins (1 − α = exp(−τ)).
 TEST(ReferenceKernels, SingleVoxelIntegratesToItsMass) {
     const double h = 0.5;
     const Volume v = singleVoxel(h);
@@ -56,6 +57,9 @@ TEST(ReferenceKernels, SingleVoxelIntegratesToItsMass) {
         for (const double rho : {0.0, 0.7, 1.4, 1.6}) {
             const glm::dvec3 origin = centre + u * (rho * h) - dir * 10.0;
             EXPECT_NEAR(integrator.opticalDepth(origin, dir), sigma * k->footprint(rho), 1e-6) << k->id() << " ρ " << rho;
+            // The image path (depth bins from the kernel's erf table) deposits the same depth.
+            const double tau = -std::log1p(-integrator.integrate(origin, dir).w);
+            EXPECT_NEAR(tau, sigma * k->footprint(rho), 1e-5) << k->id() << " ρ " << rho;
         }
     }
 }
