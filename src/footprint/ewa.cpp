@@ -8,7 +8,7 @@ namespace vdbsplat {
 glm::dmat3 ewaJacobian(const ViewPoint& t) {
     const double l = glm::length(t);
     const double iz = 1.0 / t.z, iz2 = iz * iz;
-    glm::dmat3 J(0.0);  // J[col][row], eq. 16
+    glm::dmat3 J(0.0);  // J[col][row]: ∂(t0/t2, t1/t2, ‖t‖)/∂t (Zwicker et al. 2001, local affine approximation)
     J[0][0] = iz, J[1][0] = 0.0, J[2][0] = -t.x * iz2;
     J[0][1] = 0.0, J[1][1] = iz, J[2][1] = -t.y * iz2;
     J[0][2] = t.x / l, J[1][2] = t.y / l, J[2][2] = t.z / l;
@@ -22,8 +22,8 @@ glm::dmat3 worldToViewRotation(const Camera& camera) {
 glm::dmat2 ewaRaySpaceVariance(const ViewPoint& t, const glm::dmat3& worldToView, double kernelSigmaWorld) {
     const glm::dmat3 J = ewaJacobian(t);
     const glm::dmat3 Vobj = kernelSigmaWorld * kernelSigmaWorld * glm::dmat3(1.0);  // V''_k
-    const glm::dmat3 Vray = J * worldToView * Vobj * glm::transpose(worldToView) * glm::transpose(J);  // eq. 17
-    return glm::dmat2(Vray[0][0], Vray[0][1], Vray[1][0], Vray[1][1]);  // eq. 19: drop row and column 3
+    const glm::dmat3 Vray = J * worldToView * Vobj * glm::transpose(worldToView) * glm::transpose(J);  // V'_k = J W V''_k Wᵀ Jᵀ
+    return glm::dmat2(Vray[0][0], Vray[0][1], Vray[1][0], Vray[1][1]);  // integrated along x2: drop row and column 3
 }
 
 glm::dmat2 ewaScreenVariance(const ViewPoint& t, const glm::dmat3& worldToView, double kernelSigmaWorld,
@@ -37,7 +37,7 @@ EwaKernel makeEwaKernel(const Camera& camera, const ViewPoint& c, double h, doub
     EwaKernel k;
     if (!(c.z > 0.0)) return k;
     const glm::dmat2 sigma = ewaScreenVariance(c, worldToViewRotation(camera), kernelSigma * h, camera.focal());
-    const glm::dmat2 widened = sigma + std::max(prefilterVariance, 0.0) * glm::dmat2(1.0);  // eq. 20
+    const glm::dmat2 widened = sigma + std::max(prefilterVariance, 0.0) * glm::dmat2(1.0);  // resampling filter: + V_h
     const double det = glm::determinant(sigma), detW = glm::determinant(widened);
     if (!(std::isfinite(detW) && detW > 0.0 && det > 0.0)) return k;
     k.centre = camera.project(c);

@@ -4,16 +4,18 @@
 // column dropped, the low-pass V_h added, and the resulting Gaussian splat (conic, amplitude,
 // bounds) that `--mode ewa` draws for every voxel.
 //
-// Zwicker et al. 2001 (EWA Volume Splatting), §4–5; the equation numbers are the paper's:
-//   ray space  x = m(t) = (t0/t2, t1/t2, ‖t‖)ᵀ                            (eq. 15)
-//   Jacobian   J_k = ∂m/∂t at t_k = the voxel's view-space centre           (eq. 16)
+// Zwicker et al. 2001 (EWA Volume Splatting), the sections on the viewing and projective
+// transformations and on the resampling filter, cited by name (the equation numbers differ
+// between the 2001 paper and the 2002 journal version; docs/kernel.md §8):
+//   ray space  x = m(t) = (t0/t2, t1/t2, ‖t‖)ᵀ                 (the projective mapping to ray space)
+//   Jacobian   J_k = ∂m/∂t at t_k = the voxel's view-space centre (its local affine approximation)
 //              ⎡1/t2   0    −t0/t2²⎤
 //              ⎢ 0   1/t2   −t1/t2²⎥
 //              ⎣t0/l  t1/l   t2/l  ⎦,   l = ‖t_k‖
-//   V'_k = J_k W V''_k Wᵀ J_kᵀ  (eq. 17): W the viewing rotation (world → view), V''_k the
+//   V'_k = J_k W V''_k Wᵀ J_kᵀ  (the ray-space kernel): W the viewing rotation (world → view), V''_k the
 //          kernel's object-space variance, here (s_g·h)²·I (world units²);
 //   footprint: integrating the ray-space Gaussian along x2 drops the third row and column
-//          (eq. 19, the 2×2 matrix V̂'_k); resampling filter: + V_h = I (eq. 20).
+//          (the 2×2 matrix V̂'_k); the EWA resampling filter: + V_h = I.
 // In pixels the image-plane map is p = principal + (f·x0, −f·x1), so the 2×2 variance is
 //     Σ = S·V̂'·Sᵀ,  S = diag(f, −f),      Σ' = Σ + V_h·I.
 //
@@ -36,11 +38,11 @@
 
 namespace vdbsplat {
 
-/// @brief J_k of Zwicker et al. 2001 eq. 16: the Jacobian of the ray-space map
+/// @brief J_k of Zwicker et al. 2001 (the local affine approximation): the Jacobian of the ray-space map
 /// m(t) = (t0/t2, t1/t2, ‖t‖) at view point @p t (t2 > 0). GLM is column-major: J[col][row].
 glm::dmat3 ewaJacobian(const ViewPoint& t);
 
-/// @brief The ray-space footprint variance V̂'_k (eq. 17 and 19): the upper-left 2×2 block of
+/// @brief The ray-space footprint variance V̂'_k (Zwicker et al. 2001): the upper-left 2×2 block of
 /// J·W·V''·Wᵀ·Jᵀ for an isotropic object-space kernel of standard deviation @p kernelSigmaWorld,
 /// with W = @p worldToView (a rotation; V'' = s²·I). Units: (image plane at z = 1)².
 glm::dmat2 ewaRaySpaceVariance(const ViewPoint& t, const glm::dmat3& worldToView, double kernelSigmaWorld);
@@ -54,7 +56,7 @@ struct EwaKernel {
     PixelCoord centre{0.0};    ///< the projection of the voxel centre (the affine map's origin)
     glm::dmat2 variance{0.0};  ///< Σ' (px²)
     glm::dmat2 conic{0.0};     ///< Q = (s_g/R)²·Σ'⁻¹: i² = (p − centre)ᵀ Q (p − centre) ≤ 1 on the support
-    double amplitude = 0.0;    ///< √(det Σ / det Σ'): keeps the total (eq. 20 with Σ's normalisation)
+    double amplitude = 0.0;    ///< √(det Σ / det Σ'): keeps the total (the resampling filter, Σ's normalisation)
     PixelBox bounds;           ///< exact bounding box of the support ellipse
     /// @brief i² at pixel coordinate @p p.
     double index2(const PixelCoord& p) const {

@@ -23,7 +23,7 @@ ScreenKernel makeSwanKernel(const SphereProjection& e, double prefilterVariance,
     ScreenKernel k = makeScreenKernel(e, 0.0);  // the exact ellipse, amplitude 1
     k.a *= s, k.b *= s;
     k.conic /= s * s;
-    k.amplitude = 1.0 / (s * s);  // Swan §3: height scaled by 1/s² keeps the 2D integral
+    k.amplitude = 1.0 / (s * s);  // Swan et al. 1997: height scaled by 1/s² keeps the 2D integral
     k.pullback = glm::dmat2(1.0 / s);
     k.bounds = {k.centre + (k.bounds.lo - k.centre) * s, k.centre + (k.bounds.hi - k.centre) * s};
     return k;

@@ -3,9 +3,10 @@
 // the amplitude scaled so that the deposit's total is unchanged.
 //
 // Swan, Mueller, Möller, Shareef, Crawfis, Yagel 1997 ("An Anti-Aliasing Technique for
-// Splatting"), §3: when the projected voxel spacing falls below the screen's sampling rate, the
-// splat kernel is scaled up in screen space by the ratio of the two rates, and its height is
-// scaled down by the same factor squared (for a 2D footprint) so that its integral is kept.
+// Splatting"), its anti-aliasing method, cited by name: when the projected voxel spacing falls
+// below the screen's sampling rate, the splat kernel is scaled up in screen space by the ratio of
+// the two rates, and its height down by the same factor squared (for a 2D footprint) so that its
+// integral is kept.
 // Here the "rate" of the screen is the pixel filter: the stretch s makes the footprint's narrowest
 // standard deviation at least the low-pass's √V_h,
 //     s = max(1, √V_h / σ_min),   σ_min = b·s_g/R   (b the exact ellipse's minor semi-axis),

@@ -1,5 +1,5 @@
 // tests/footprint/ewa_test.cpp — EWA volume splatting's affine screen kernel (footprint/ewa.h,
-// Zwicker et al. 2001 eq. 15–20) against slow, obvious oracles: a finite-difference Jacobian of
+// Zwicker et al. 2001) against slow, obvious oracles: a finite-difference Jacobian of
 // the ray-space map and of the camera's projection, the energy rule (the point's total), and the
 // exact perspective ellipse it approximates (equal on the axis as α → 0, not off the axis).
 #include <gtest/gtest.h>
@@ -25,7 +25,7 @@ ViewPoint at(double D, double theta, double phi = 0.3) {
     return D * glm::dvec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
 }
 
-/// m(t) = (t0/t2, t1/t2, ‖t‖): Zwicker et al. 2001 eq. 15.
+/// m(t) = (t0/t2, t1/t2, ‖t‖): the ray-space map of Zwicker et al. 2001.
 glm::dvec3 raySpace(const glm::dvec3& t) { return {t.x / t.z, t.y / t.z, glm::length(t)}; }
 
 TEST(Ewa, JacobianMatchesFiniteDifferencesOfTheRaySpaceMap) {
