@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "footprint/kernel.h"
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "cli/render_flags.h"
@@ -52,7 +53,8 @@ const char* kHelp =
     "  --runs N             timed runs per view and mode, 1..1000 (default 5)\n"
     "  --warmup N           untimed rounds before them, 0..100 (default 1)\n"
     "  --threads N          worker threads (default: all cores)\n"
-    "  --modes LIST         comma-separated, from hybrid, splat, point, reference\n"
+    "  --modes LIST         comma-separated, from hybrid, splat, point, ewa, swan, none, reference\n"
+    "  --kernel K           gaussian (default) | gaussian-sharp, as for render\n"
     "                       (default hybrid,splat,point; reference is slow)\n"
     "  --distances LIST     comma-separated framing distances (default 8,1,0.35)\n"
     "  --view-dir X,Y,Z     framing direction, centre to eye (default 0.9,-1.3,0.75)\n"
@@ -90,11 +92,11 @@ std::vector<RenderMode> parseModes(const std::string& text) {
     std::vector<RenderMode> modes;
     for (const std::string& item : splitList(text, "--modes")) {
         RenderMode mode;
-        if (item == "hybrid") mode = RenderMode::Hybrid;
-        else if (item == "splat") mode = RenderMode::Splat;
-        else if (item == "point") mode = RenderMode::Point;
-        else if (item == "reference") mode = RenderMode::Reference;
-        else throw Error("--modes: unknown mode '" + item + "' (choose hybrid, splat, point, reference)");
+        try {
+            mode = parseRenderMode(item);
+        } catch (const Error&) {
+            throw Error("--modes: unknown mode '" + item + "' (choose " + kRenderModeNames + ")");
+        }
         if (std::find(modes.begin(), modes.end(), mode) != modes.end())
             throw Error("--modes: '" + item + "' given more than once");
         modes.push_back(mode);
@@ -161,6 +163,7 @@ Options optionsFrom(const Args& args) {
     }
     s.shading = shadingFromFlags(args);
     s.emission = emissionFromFlags(args);
+    if (auto v = args.get("--kernel")) s.kernel = KernelShape::named(*v).id();
     if (auto v = args.get("--runs")) o.runs = int(parseInt(*v, "--runs", 1, kMaxRuns));
     if (auto v = args.get("--warmup")) o.warmup = int(parseInt(*v, "--warmup", 0, kMaxWarmup));
     if (auto v = args.get("--modes")) o.modes = parseModes(*v);
@@ -219,7 +222,7 @@ std::string formatDistance(double d) {
 int runBench(const Argv& argv) {
     std::set<std::string> valueFlags{"--grid",      "--tf",  "--size", "--runs",      "--warmup", "--threads",
                                      "--modes",     "--distances", "--threshold", "--lod", "--simd",
-                                     "--footprint", "--filter-order", "--subpixels", "--json", "--view-dir", "--up"};
+                                     "--footprint", "--filter-order", "--subpixels", "--kernel", "--json", "--view-dir", "--up"};
     valueFlags.insert(shadingValueFlags().begin(), shadingValueFlags().end());
     valueFlags.insert(emissionValueFlags().begin(), emissionValueFlags().end());
     const Args args(argv, valueFlags, {"-v"});

@@ -13,7 +13,8 @@ namespace vdbsplat::cli {
 
 namespace {
 const char* kHelp =
-    "usage: vdbsplat tables --out DIR      write footprint.table and reindex.table into DIR\n"
+    "usage: vdbsplat tables --out DIR      write footprint.table, footprint-gaussian-sharp.table\n"
+    "                                      (one per --kernel) and reindex.table into DIR\n"
     "       vdbsplat tables --check [DIR]  verify DIR (default: the shipped tables/ directory):\n"
     "                                      header, kernel, checksum, and byte-for-byte equality\n"
     "                                      with a fresh build; exits non-zero on any mismatch\n"
@@ -22,10 +23,14 @@ const char* kHelp =
     "distance d; the reindex table is d²(i², α) for α in [0°, 15°] (DESIGN §3).\n";
 
 int writeTables(const std::string& dir) {
+    for (const KernelShape* kernel : {&KernelShape::standard(), &KernelShape::sharp()}) {
+        const Tables k = buildTables(*kernel);
+        saveTables(k, dir);
+        std::printf("wrote %s/%s (kernel %s, %d intervals in d², max error %.3e)\n", dir.c_str(),
+                    footprintTableFile(*kernel).c_str(), kernel->tableName(), k.footprint.intervals(),
+                    k.footprint.maxAbsError());
+    }
     const Tables t = buildTables();
-    saveTables(t, dir);
-    std::printf("wrote %s/%s (kernel %s, %d intervals in d², max error %.3e)\n", dir.c_str(), kFootprintTableFile,
-                Kernel::kName, t.footprint.intervals(), t.footprint.maxAbsError());
     std::printf("wrote %s/%s (%d × %d intervals in i² × α ∈ [0°, %g°], max error %.3e)\n", dir.c_str(),
                 kReindexTableFile, t.reindex.intervalsI2(), t.reindex.intervalsAlpha(), t.reindex.alphaMaxDeg(),
                 t.reindex.maxAbsError());

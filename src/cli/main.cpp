@@ -15,7 +15,7 @@ const char* kUsage =
     "usage: vdbsplat <command> [options]   (vdbsplat <command> --help for details)\n"
     "\n"
     "commands:\n"
-    "  render    render a .vdb grid to PNG or EXR (reference, hybrid, splat, point)\n"
+    "  render    render a .vdb grid to PNG or EXR (reference, hybrid, splat, point, ewa, swan, none)\n"
     "  animate   render a camera path (zoom, orbit, keyframes) to frames, with per-frame stats\n"
     "  info      describe every grid in a .vdb file\n"
     "  generate  write a test volume (checkerbox, marschner-lobb, sphere, cloud)\n"

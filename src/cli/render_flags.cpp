@@ -1,6 +1,7 @@
 // cli/render_flags.cpp — render flags → RenderSettings (see render_flags.h).
 #include "cli/render_flags.h"
 
+#include "footprint/kernel.h"
 #include "util/error.h"
 #include "util/parse.h"
 
@@ -10,7 +11,7 @@ const std::set<std::string>& renderValueFlags() {
     static const std::set<std::string> flags{"--grid",   "--mode",      "--size",      "--tf",    "--eye",
                                              "--look-at", "--up",       "--view-dir",  "--fov",   "--distance",
                                              "--threads", "--spp",      "--threshold", "--lod",   "--footprint",
-                                             "--tables",  "--simd", "--max-voxels", "--filter-order", "--subpixels", "--shading",
+                                             "--tables",  "--simd", "--max-voxels", "--filter-order", "--subpixels", "--kernel", "--shading",
                                              "--ambient", "--diffuse",  "--specular",  "--shininess",
                                              "--light",   "--gradient-opacity", "--emission", "--emission-map",
                                              "--emission-scale", "--kelvin"};
@@ -114,6 +115,7 @@ RenderSettings settingsFromFlags(const Args& args) {
     if (auto v = args.get("--max-voxels"))
         s.maxActiveVoxels = uint64_t(parseInt(*v, "--max-voxels", 1, (long long)kHardMaxActiveVoxels));
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
+    if (auto v = args.get("--kernel")) s.kernel = KernelShape::named(*v).id();
     applyFilterFlags(args, s);
     if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
     if (auto v = args.get("--simd")) {

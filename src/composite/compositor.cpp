@@ -440,12 +440,13 @@ void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
         return;
     }
     const double h = exact_.voxelSize;
-    const SphereProjection sphere = projectSphere(camera, ViewPoint(p.viewPos), Kernel::kRadius * h);
+    const KernelShape& shape = *tables_.kernel;
+    const SphereProjection sphere = projectSphere(camera, ViewPoint(p.viewPos), shape.radius() * h);
     // Recomputed from the float view position: a borderline sphere may no longer be an
     // Ellipse, and then takes the half-ray fallback like a NearEye kernel.
     const bool widened = p.kind != PrimitiveKind::NearEye && sphere.isEllipse();
     ScreenKernel kernel;
-    if (widened) kernel = makeScreenKernel(sphere, exact_.prefilterVariance);
+    if (widened) kernel = makeScreenKernel(sphere, exact_.prefilterVariance, shape);
     const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
     const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
     const double sigmaWorld = p.sigma / h;
@@ -455,7 +456,7 @@ void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
             if (!px.live(i)) continue;
             const PixelCoord q(x + 0.5, y + 0.5);
             const double tau =
-                widened ? splatDepositExact(kernel, sphere, sigmaWorld, h, q) : p.sigma * halfRayFootprint(sphere, q);
+                widened ? splatDepositExact(kernel, sphere, sigmaWorld, h, q, shape) : p.sigma * halfRayFootprint(sphere, q, shape);
             if (tau > 0.0) px.over(i, float(tau), p.color);
         }
 }

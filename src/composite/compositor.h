@@ -43,7 +43,7 @@ struct ExactContext {
     double prefilterVariance = kPrefilterVariance;
     /// The kernels' shape in view space (footprint/ellipsoid.h); null or a sphere: spheres.
     /// Ellipsoid kernels at the eye (NearEye) take the exact index-space half-ray integral.
-    const KernelShape* shape = nullptr;
+    const VoxelShape* shape = nullptr;
 };
 
 /// Primitives composite() dropped because every tile they touch is already opaque.

@@ -135,14 +135,14 @@ double exactRayDistance2(const SphereProjection& s, const PixelCoord& p) {
     return glm::dot(w, w) / (glm::dot(v, v) * s.r * s.r);
 }
 
-double halfRayFootprint(const SphereProjection& s, const PixelCoord& p) {
+double halfRayFootprint(const SphereProjection& s, const PixelCoord& p, const KernelShape& kernel) {
     if (!(s.r > 0.0) || s.kind == SphereClass::Behind) return 0.0;
     const glm::dvec3 v = glm::normalize(pixelRay(s, p));
-    const double toVoxel = Kernel::kRadius / s.r;  // r world units = R voxels
+    const double toVoxel = kernel.radius() / s.r;  // r world units = R voxels
     const double tStar = glm::dot(s.c, v);         // ray parameter of the closest point
     const double rho = glm::length(glm::cross(s.c, v));
     // The ray starts at the eye (t = 0), i.e. at −t* from the closest point.
-    return Kernel::segmentIntegral(rho * toVoxel, -tStar * toVoxel, Kernel::kRadius);
+    return kernel.segmentIntegral(rho * toVoxel, -tStar * toVoxel, kernel.radius());
 }
 
 }  // namespace vdbsplat

@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "camera/camera.h"
+#include "footprint/kernel.h"
 #include "footprint/pixel_box.h"
 
 namespace vdbsplat {
@@ -97,6 +98,8 @@ double exactRayDistance2(const SphereProjection& s, const PixelCoord& p);
 /// HALF-ray t ≥ 0 from the eye through pixel @p p (Kernel::segmentIntegral). Equals
 /// Kernel::footprint(R·exactRayDistance) for an Ellipse; the fallback for EyeInside and
 /// Straddles (the part of the kernel behind the eye is not seen). Deposit = σ·h·this.
-double halfRayFootprint(const SphereProjection& s, const PixelCoord& p);
+/// @p kernel: the kernel whose support the sphere is (s.r = kernel.radius()·h).
+double halfRayFootprint(const SphereProjection& s, const PixelCoord& p,
+                        const KernelShape& kernel = KernelShape::standard());
 
 }  // namespace vdbsplat

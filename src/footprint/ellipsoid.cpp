@@ -40,7 +40,7 @@ void fillFromConic(SphereProjection& s, const PixelCoord& centre, double qxx, do
 
 /// The silhouette conic of an ellipsoid in front of the eye plane; false when it is not a
 /// proper ellipse (numerically degenerate): the caller then takes the half-ray fallback.
-bool silhouette(const KernelShape& shape, const ViewPoint& c, SphereProjection& s) {
+bool silhouette(const VoxelShape& shape, const ViewPoint& c, SphereProjection& s) {
     // Inside ⟺ vᵀ C v ≥ 0 with C = R² M⁻ᵀM⁻¹ − [c]ₓᵀ M Mᵀ [c]ₓ / det²M (ellipsoid.h).
     const glm::dmat3 cx = crossMatrix(c);
     const glm::dmat3 C = kR * kR * (glm::transpose(shape.N) * shape.N) -
@@ -81,8 +81,8 @@ glm::dvec3 singularValues(const glm::dmat3& m) {
     return glm::sqrt(glm::max(e, glm::dvec3(0.0)));
 }
 
-KernelShape KernelShape::of(const glm::dmat3& m) {
-    KernelShape k;
+VoxelShape VoxelShape::of(const glm::dmat3& m) {
+    VoxelShape k;
     k.M = m;
     k.N = glm::inverse(m);
     k.volume = std::abs(glm::determinant(m));
@@ -93,7 +93,7 @@ KernelShape KernelShape::of(const glm::dmat3& m) {
     return k;
 }
 
-EllipsoidProjection projectEllipsoid(const KernelShape& shape, const ViewPoint& c, double f, const PixelCoord& principal) {
+EllipsoidProjection projectEllipsoid(const VoxelShape& shape, const ViewPoint& c, double f, const PixelCoord& principal) {
     EllipsoidProjection out;
     SphereProjection& s = out.ellipse;
     if (!finite3(c) || !(f > 0.0) || !std::isfinite(f) || !std::isfinite(principal.x) || !std::isfinite(principal.y))
@@ -116,18 +116,18 @@ EllipsoidProjection projectEllipsoid(const KernelShape& shape, const ViewPoint& 
     return out;
 }
 
-double ellipsoidRayDistance2(const KernelShape& shape, const ViewPoint& c, const glm::dvec3& v) {
+double ellipsoidRayDistance2(const VoxelShape& shape, const ViewPoint& c, const glm::dvec3& v) {
     const glm::dvec3 w = glm::transpose(shape.M) * glm::cross(c, v) / shape.volume, vi = shape.N * v;
     return glm::dot(w, w) / (glm::dot(vi, vi) * kR * kR);
 }
 
-bool rayHitsEllipsoid(const KernelShape& shape, const ViewPoint& c, const glm::dvec3& v) {
+bool rayHitsEllipsoid(const VoxelShape& shape, const ViewPoint& c, const glm::dvec3& v) {
     const glm::dvec3 nv = shape.N * v, nc = shape.N * c;  // Q = NᵀN: vᵀQc = (Nv)·(Nc)
     const double b = glm::dot(nv, nc), a = glm::dot(nv, nv), k = glm::dot(nc, nc) - kR * kR;
     return b * b - a * k >= 0.0;
 }
 
-ExactIndexMap makeEllipsoidIndexMap(const ScreenKernel& k, const EllipsoidProjection& e, const KernelShape& shape,
+ExactIndexMap makeEllipsoidIndexMap(const ScreenKernel& k, const EllipsoidProjection& e, const VoxelShape& shape,
                                     const PixelCoord& origin) {
     const SphereProjection& s = e.ellipse;
     // The view rays of the pulled-back pixels, affine in δ (as makeExactIndexMap), then into index space.
@@ -144,7 +144,7 @@ ExactIndexMap makeEllipsoidIndexMap(const ScreenKernel& k, const EllipsoidProjec
     return m;
 }
 
-double ellipsoidHalfRayDeposit(const KernelShape& shape, const ViewPoint& c, const glm::dvec3& v) {
+double ellipsoidHalfRayDeposit(const VoxelShape& shape, const ViewPoint& c, const glm::dvec3& v) {
     const glm::dvec3 vi = shape.N * glm::normalize(v);  // index length per world length along v
     const double perWorld = glm::length(vi);
     if (!(perWorld > 0.0)) return 0.0;

@@ -1,6 +1,6 @@
 // footprint/ellipsoid.h — the exact perspective projection of one kernel ELLIPSOID: DESIGN §2
 // generalised through the kernel's index space (docs/kernel.md, "Any voxel shape").
-// Owns: KernelShape (the linear part M of a grid's index→view map, its inverse, singular
+// Owns: VoxelShape (the linear part M of a grid's index→view map, its inverse, singular
 // values and volume), projectEllipsoid (class, the silhouette ellipse, and a SphereProjection
 // stand-in carrying it so that the EWA widening of screen_kernel.h applies unchanged), the
 // exact index-space ray–centre distance and its ExactIndexMap, the half-ray integral for
@@ -25,7 +25,7 @@
 namespace vdbsplat {
 
 /// @brief The shape of every kernel of a grid in view space (one per render).
-struct KernelShape {
+struct VoxelShape {
     glm::dmat3 M{1.0};   ///< index → view linear part (world units per index unit)
     glm::dmat3 N{1.0};   ///< M⁻¹
     double volume = 1.0; ///< |det M|: the kernel's world volume per unit index volume (h³ for cubes)
@@ -34,7 +34,7 @@ struct KernelShape {
     bool sphere = true;  ///< M = h·(rotation) to 1e−9: the sphere paths (tables, DESIGN §2) apply
 
     /// @brief The shape of the linear map @p m (must be non-singular).
-    static KernelShape of(const glm::dmat3& m);
+    static VoxelShape of(const glm::dmat3& m);
     /// @brief World length per unit of index length along view direction @p v (any length):
     /// |v| / |M⁻¹v|; h for a sphere.
     double lengthAlong(const glm::dvec3& v) const { return glm::length(v) / glm::length(N * v); }
@@ -68,27 +68,27 @@ struct EllipsoidProjection {
 /// Behind: entirely behind the eye plane. EyeInside: |M⁻¹c| ≤ R. Straddles: the ellipsoid
 /// crosses the eye plane (its z-extent R·|row₃(M)| ≥ c.z) or the conic is degenerate.
 /// Ellipse otherwise. Never NaN; non-finite input gives Behind.
-EllipsoidProjection projectEllipsoid(const KernelShape& shape, const ViewPoint& c, double f, const PixelCoord& principal);
+EllipsoidProjection projectEllipsoid(const VoxelShape& shape, const ViewPoint& c, double f, const PixelCoord& principal);
 
 /// @brief The normalised index-space distance² d² from the kernel centre @p c to the line
 /// through the eye along view direction @p v (the formula above), without square roots.
-double ellipsoidRayDistance2(const KernelShape& shape, const ViewPoint& c, const glm::dvec3& v);
+double ellipsoidRayDistance2(const VoxelShape& shape, const ViewPoint& c, const glm::dvec3& v);
 
 /// @brief Brute-force oracle, independent of the index-space formula: the line t·v meets the
 /// world-space quadric (x − c)ᵀ M⁻ᵀM⁻¹ (x − c) ≤ R² (its discriminant is ≥ 0).
-bool rayHitsEllipsoid(const KernelShape& shape, const ViewPoint& c, const glm::dvec3& v);
+bool rayHitsEllipsoid(const VoxelShape& shape, const ViewPoint& c, const glm::dvec3& v);
 
 /// @brief The ExactIndexMap of the widened kernel @p k of an ellipsoid projection @p e
 /// (δ from @p origin): the pulled-back pixel's ray carried into index space, v' = M⁻¹v and
 /// w' = Mᵀ(c × v)/|det M|, so that d² = |w'|²/|v'|²/R² — the same map the compositor's
 /// exact-index loop reads for spheres.
-ExactIndexMap makeEllipsoidIndexMap(const ScreenKernel& k, const EllipsoidProjection& e, const KernelShape& shape,
+ExactIndexMap makeEllipsoidIndexMap(const ScreenKernel& k, const EllipsoidProjection& e, const VoxelShape& shape,
                                     const PixelCoord& origin);
 
 /// @brief The optical depth per unit σ·(voxel length) deposited on the HALF-ray from the
 /// eye along view direction @p v by the kernel at @p c (the fallback for kernels at the eye,
 /// as halfRayFootprint for spheres): the index-space half-ray integral of the normalised
 /// kernel times the world length per index length along v, over h (σ_k·h·this = τ).
-double ellipsoidHalfRayDeposit(const KernelShape& shape, const ViewPoint& c, const glm::dvec3& v);
+double ellipsoidHalfRayDeposit(const VoxelShape& shape, const ViewPoint& c, const glm::dvec3& v);
 
 }  // namespace vdbsplat

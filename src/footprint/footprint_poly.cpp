@@ -15,9 +15,9 @@ namespace {
 double reindexD2(double t, double s2) { return t / ((1.0 - s2) + t * s2); }
 
 /// G_α(t) = F(d(t)) / √(1 − t), t < 1 (voxel units, as the footprint table).
-double g(double t, double s2) {
+double g(double t, double s2, const KernelShape& kernel) {
     const double d2 = reindexD2(t, s2);
-    return Kernel::footprint(Kernel::kRadius * std::sqrt(std::max(d2, 0.0))) / std::sqrt(1.0 - t);
+    return kernel.footprint(kernel.radius() * std::sqrt(std::max(d2, 0.0))) / std::sqrt(1.0 - t);
 }
 
 /// Solves the (n × n) system A·c = y by Gaussian elimination with partial pivoting.
@@ -45,7 +45,7 @@ std::vector<double> solve(std::vector<std::vector<double>> a, std::vector<double
 }
 
 /// Interpolates G_α at the Chebyshev nodes of x = 2t − 1 ∈ (−1, 1): monomial coefficients in x.
-FootprintPolynomials::Coefficients fitRow(double s2) {
+FootprintPolynomials::Coefficients fitRow(double s2, const KernelShape& kernel) {
     constexpr int n = FootprintPolynomials::kCoefficients;
     std::vector<std::vector<double>> vandermonde(n, std::vector<double>(n));
     std::vector<double> values(n);
@@ -53,7 +53,7 @@ FootprintPolynomials::Coefficients fitRow(double s2) {
         const double x = std::cos(std::numbers::pi * (k + 0.5) / n);
         double p = 1.0;
         for (int j = 0; j < n; ++j, p *= x) vandermonde[size_t(k)][size_t(j)] = p;
-        values[size_t(k)] = g(0.5 * (x + 1.0), s2);
+        values[size_t(k)] = g(0.5 * (x + 1.0), s2, kernel);
     }
     const std::vector<double> c = solve(std::move(vandermonde), std::move(values));
     FootprintPolynomials::Coefficients out{};
@@ -63,12 +63,12 @@ FootprintPolynomials::Coefficients fitRow(double s2) {
 
 }  // namespace
 
-FootprintPolynomials FootprintPolynomials::build() {
+FootprintPolynomials FootprintPolynomials::build(const KernelShape& kernel) {
     FootprintPolynomials p;
     const double s = std::sin(kAlphaMaxDeg * std::numbers::pi / 180.0);
     p.sin2Max_ = s * s;
     p.rows_.reserve(kRows + 1);
-    for (int r = 0; r <= kRows; ++r) p.rows_.push_back(fitRow(p.sin2Max_ * r / kRows));
+    for (int r = 0; r <= kRows; ++r) p.rows_.push_back(fitRow(p.sin2Max_ * r / kRows, kernel));
     return p;
 }
 
@@ -91,8 +91,8 @@ float FootprintPolynomials::evaluate(const Coefficients& c, float t) {
     return std::max(std::sqrt(1.0f - t) * p, 0.0f);
 }
 
-double FootprintPolynomials::measureError() const {
-    const double f0 = Kernel::footprint(0.0);
+double FootprintPolynomials::measureError(const KernelShape& kernel) const {
+    const double f0 = kernel.footprint(0.0);
     double worst = 0.0;
     constexpr int kAlphas = 4 * kRows, kTs = 2000;
     for (int a = 0; a <= kAlphas; ++a) {
@@ -100,7 +100,7 @@ double FootprintPolynomials::measureError() const {
         const Coefficients c = row(s2);
         for (int i = 0; i < kTs; ++i) {
             const double t = double(i) / kTs;
-            const double exact = Kernel::footprint(Kernel::kRadius * std::sqrt(reindexD2(t, s2)));
+            const double exact = kernel.footprint(kernel.radius() * std::sqrt(reindexD2(t, s2)));
             worst = std::max(worst, std::abs(double(evaluate(c, float(t))) - exact) / f0);
         }
     }

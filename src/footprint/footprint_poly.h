@@ -17,6 +17,8 @@
 #include <array>
 #include <vector>
 
+#include "footprint/kernel.h"
+
 namespace vdbsplat {
 
 class FootprintPolynomials {
@@ -30,7 +32,7 @@ public:
     using Coefficients = std::array<float, kCoefficients>;  ///< c_0 … c_10 in x = 2t − 1
 
     /// @brief Fits every row from Kernel::footprint (deterministic, in memory, well under 1 ms).
-    static FootprintPolynomials build();
+    static FootprintPolynomials build(const KernelShape& kernel = KernelShape::standard());
 
     /// @brief True when a splat of half cone angle with sin²α = @p sin2Alpha is covered.
     bool covers(double sin2Alpha) const { return sin2Alpha >= 0.0 && sin2Alpha <= sin2Max_; }
@@ -44,7 +46,7 @@ public:
 
     double sin2Max() const { return sin2Max_; }
     /// @brief Max |evaluate − Kernel::footprint| / F(0) over a dense sampling of t and α.
-    double measureError() const;
+    double measureError(const KernelShape& kernel = KernelShape::standard()) const;
 
 private:
     std::vector<Coefficients> rows_;  // kRows + 1

@@ -12,9 +12,53 @@
 //
 // Units: "voxel units" — distances divided by the voxel size h.
 #pragma once
+#include <string>
 
 namespace vdbsplat {
 
+/// @brief One truncated Gaussian reconstruction kernel (DESIGN §1), normalised to unit volume
+/// integral over its support (voxel units): the study axis `--kernel` (docs/kernel.md §10).
+/// `Kernel` below is the standard one; KernelShape::sharp() is a narrower Gaussian whose
+/// response at the grid's Nyquist frequency is closer to trilinear's. Every radius here is
+/// ≤ Kernel::kRadius, which the stream's culling and the crop use as the bound.
+class KernelShape {
+public:
+    /// @param id the --kernel name; @param tableName the name written into table headers.
+    KernelShape(const char* id, const char* tableName, double sigma, double radius);
+
+    const char* id() const { return id_; }
+    const char* tableName() const { return tableName_; }
+    double sigma() const { return sigma_; }    ///< s_g (voxels)
+    double radius() const { return radius_; }  ///< R (voxels)
+    double normalization() const { return norm_; }  ///< 1 / ∫_{|x|<R} exp(−|x|²/2s_g²) dV
+
+    /// @brief g(x) for |x|² = @p s2 (voxel units²); 0 outside the support.
+    double value(double s2) const;
+    /// @brief The line integral of g along a ray at distance @p rho from the centre between
+    /// signed parameters @p t0 ≤ @p t1 from the closest point (voxel units), clipped to the chord.
+    double segmentIntegral(double rho, double t0, double t1) const;
+    /// @brief F(ρ), the line integral along the full chord (closed form with erf); ∫∫F dA = 1.
+    double footprint(double rho) const { return segmentIntegral(rho, -radius_, radius_); }
+    /// @brief ∫∫ F over the plane, numerically (midpoint rule; for tests).
+    double footprintPlaneIntegral(int steps = 4096) const;
+    /// @brief The 3D integral of g over its support, numerically on a @p n³ grid (for tests: 1).
+    double volumeIntegral(int n = 160) const;
+
+    /// The standard kernel (Kernel's constants): --kernel gaussian.
+    static const KernelShape& standard();
+    /// s_g = 0.5, R = 1.55 (3.1 s_g): --kernel gaussian-sharp.
+    static const KernelShape& sharp();
+    /// @throw Error "--kernel: unknown kernel '<name>' (choose gaussian, gaussian-sharp)".
+    static const KernelShape& named(const std::string& name);
+    static constexpr const char* kNames = "gaussian, gaussian-sharp";  ///< for --help and errors
+
+private:
+    const char* id_;
+    const char* tableName_;
+    double sigma_, radius_, norm_;
+};
+
+/// The standard kernel as constants (KernelShape::standard() is the same kernel as a value).
 struct Kernel {
     static constexpr double kSigma = 0.65;   ///< s_g, the Gaussian's standard deviation (voxels)
     static constexpr double kRadius = 2.0;   ///< R, the truncation radius (voxels)

@@ -18,11 +18,11 @@ glm::dmat2 inFrame(const glm::dvec2& u, double x, double y) {
 }
 }  // namespace
 
-ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVariance) {
+ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVariance, const KernelShape& kernel) {
     if (!e.isEllipse())
         throw std::invalid_argument(std::string("makeScreenKernel: sphere is '") + sphereClassName(e.kind) +
                                     "', not an ellipse (use the halfRayFootprint fallback)");
-    const double toSupport = Kernel::kRadius / Kernel::kSigma;  // std → support semi-axis
+    const double toSupport = kernel.radius() / kernel.sigma();  // std → support semi-axis
     // V = R_u diag((a s_g/R)², (b s_g/R)²) R_uᵀ; V' = V + V_h I has the same eigenvectors.
     const double widen = toSupport * toSupport * std::max(prefilterVariance, 0.0);
     ScreenKernel k;
@@ -73,10 +73,10 @@ ExactIndexMap makeExactIndexMap(const ScreenKernel& k, const SphereProjection& e
 }
 
 double splatDepositExact(const ScreenKernel& k, const SphereProjection& e, double sigma, double h,
-                         const PixelCoord& p) {
+                         const PixelCoord& p, const KernelShape& kernel) {
     const double d2 = exactIndexD2(k, e, p);
     if (!(d2 < 1.0)) return 0.0;
-    return sigma * h * Kernel::footprint(std::sqrt(d2) * Kernel::kRadius) * k.amplitude;
+    return sigma * h * kernel.footprint(std::sqrt(d2) * kernel.radius()) * k.amplitude;
 }
 
 }  // namespace vdbsplat

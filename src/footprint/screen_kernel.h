@@ -18,6 +18,7 @@
 
 #include "camera/camera.h"
 #include "footprint/ellipse.h"
+#include "footprint/kernel.h"
 #include "footprint/prefilter.h"
 #include "footprint/pixel_box.h"
 #include "footprint/tables.h"
@@ -50,7 +51,9 @@ struct ScreenKernel {
 /// @brief The EWA screen kernel of the Ellipse @p e with low-pass variance
 /// @p prefilterVariance (px²; 0 gives the unfiltered exact ellipse, amplitude 1).
 /// @throw std::invalid_argument when @p e is not an Ellipse (see projectSphere's fallback).
-ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVariance = kPrefilterVariance);
+/// @p kernel: its R/s_g converts standard deviations to the support (the standard kernel by default).
+ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVariance = kPrefilterVariance,
+                              const KernelShape& kernel = KernelShape::standard());
 
 /// @brief Per-pixel optical depth of one splat on the TABLE path, prepared once per splat:
 ///     τ(p) = σ_k · h · F(d) · amplitude,   d² = reindex(i², α) (2D table), F from the 1D table.
@@ -114,6 +117,6 @@ ExactIndexMap makeExactIndexMap(const ScreenKernel& k, const SphereProjection& e
 /// tables' interpolation error (DESIGN §3), which is what it is there to measure.
 /// Uses the closed form Kernel::footprint (erf): a measuring tool, not for the hot loop.
 double splatDepositExact(const ScreenKernel& k, const SphereProjection& e, double sigma, double h,
-                         const PixelCoord& p);
+                         const PixelCoord& p, const KernelShape& kernel = KernelShape::standard());
 
 }  // namespace vdbsplat

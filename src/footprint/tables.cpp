@@ -14,6 +14,7 @@
 #include <map>
 #include <numbers>
 #include <sstream>
+#include <tuple>
 
 #include "footprint/kernel.h"
 #include "footprint/reindex.h"
@@ -57,13 +58,13 @@ std::string hex64(std::uint64_t h) {
 }
 
 /// Header lines common to both tables (kernel identity, version).
-std::string commonHeader(const char* kind) {
+std::string commonHeader(const char* kind, const KernelShape& kernel) {
     std::string h = std::string(kMagic) + "\n";
     h += "format_version " + std::to_string(kTableFormatVersion) + "\n";
     h += std::string("table ") + kind + "\n";
-    h += std::string("kernel ") + Kernel::kName + "\n";
-    h += "sigma " + fmt("%.10g", Kernel::kSigma) + "\n";
-    h += "radius " + fmt("%.10g", Kernel::kRadius) + "\n";
+    h += std::string("kernel ") + kernel.tableName() + "\n";
+    h += "sigma " + fmt("%.10g", kernel.sigma()) + "\n";
+    h += "radius " + fmt("%.10g", kernel.radius()) + "\n";
     return h;
 }
 
@@ -123,17 +124,17 @@ ParsedFile splitFile(const std::string& bytes, const std::string& name) {
 }
 
 /// Version, table kind and kernel identity: checked before anything else in the header.
-void verifyIdentity(const ParsedFile& p, const std::string& kind) {
+void verifyIdentity(const ParsedFile& p, const std::string& kind, const KernelShape& kernel) {
     if (p.get("format_version") != std::to_string(kTableFormatVersion))
         p.fail("table format version " + p.get("format_version") + ", this build reads version " +
                std::to_string(kTableFormatVersion) + " (regenerate with `vdbsplat tables --out DIR`)");
     if (p.get("table") != kind) p.fail("is a '" + p.get("table") + "' table, expected '" + kind + "'");
     const double sigma = p.number("sigma"), radius = p.number("radius");
-    if (p.get("kernel") != Kernel::kName || std::abs(sigma - Kernel::kSigma) > 1e-9 ||
-        std::abs(radius - Kernel::kRadius) > 1e-9)
+    if (p.get("kernel") != kernel.tableName() || std::abs(sigma - kernel.sigma()) > 1e-9 ||
+        std::abs(radius - kernel.radius()) > 1e-9)
         p.fail("table built for kernel '" + p.get("kernel") + "' (s_g " + fmt("%g", sigma) + ", R " +
-               fmt("%g", radius) + "), this build uses '" + Kernel::kName + "' (s_g " +
-               fmt("%g", Kernel::kSigma) + ", R " + fmt("%g", Kernel::kRadius) + ")");
+               fmt("%g", radius) + "), this build uses '" + kernel.tableName() + "' (s_g " +
+               fmt("%g", kernel.sigma()) + ", R " + fmt("%g", kernel.radius()) + ")");
 }
 
 /// Payload size and checksum; returns the float payload.
@@ -209,25 +210,25 @@ FootprintTable::FootprintTable(std::vector<float> values, double maxAbsError, do
     scale_ = static_cast<float>(last_ + 1);
 }
 
-FootprintTable FootprintTable::build(int intervals) {
+FootprintTable FootprintTable::build(int intervals, const KernelShape& kernel) {
     std::vector<float> v(intervals + 1);
     for (int k = 0; k <= intervals; ++k) {
         const double d2 = static_cast<double>(k) / intervals;
-        v[k] = static_cast<float>(Kernel::footprint(std::sqrt(d2) * Kernel::kRadius));
+        v[k] = static_cast<float>(kernel.footprint(std::sqrt(d2) * kernel.radius()));
     }
     FootprintTable t(std::move(v), 0.0, 0.0);
-    t.maxAbsError_ = measureFootprintError(t);
+    t.maxAbsError_ = measureFootprintError(t, kernel);
     t.errorBound_ = statedBound(t.maxAbsError_);
     return t;
 }
 
-double measureFootprintError(const FootprintTable& t) {
+double measureFootprintError(const FootprintTable& t, const KernelShape& kernel) {
     constexpr int kSub = 16;
     const int n = t.intervals() * kSub;
     double worst = 0.0;
     for (int k = 0; k <= n; ++k) {
         const float d2 = static_cast<float>(static_cast<double>(k) / n);
-        const double exact = Kernel::footprint(std::sqrt(static_cast<double>(d2)) * Kernel::kRadius);
+        const double exact = kernel.footprint(std::sqrt(static_cast<double>(d2)) * kernel.radius());
         worst = std::max(worst, std::abs(t.lookupD2(d2) - exact));
     }
     return worst;
@@ -290,8 +291,8 @@ double measureReindexError(const ReindexTable& t) {
 
 // --- files -----------------------------------------------------------------------
 
-std::string serializeFootprintTable(const FootprintTable& t) {
-    std::string h = commonHeader("footprint");
+std::string serializeFootprintTable(const FootprintTable& t, const KernelShape& kernel) {
+    std::string h = commonHeader("footprint", kernel);
     h += "index d2\n";
     h += "domain 0 1\n";
     h += "intervals " + std::to_string(t.intervals()) + "\n";
@@ -300,7 +301,7 @@ std::string serializeFootprintTable(const FootprintTable& t) {
 }
 
 std::string serializeReindexTable(const ReindexTable& t) {
-    std::string h = commonHeader("reindex");
+    std::string h = commonHeader("reindex", KernelShape::standard());  // geometry only: one file for every kernel
     h += "index i2 alpha_deg (alpha rows, i2 fastest)\n";
     h += "domain_i2 0 1\n";
     h += "domain_alpha_deg 0 " + fmt("%.10g", t.alphaMaxDeg()) + "\n";
@@ -309,9 +310,9 @@ std::string serializeReindexTable(const ReindexTable& t) {
     return finishFile(h, t.values(), t.maxAbsError(), t.errorBound());
 }
 
-FootprintTable parseFootprintTable(const std::string& bytes, const std::string& name) {
+FootprintTable parseFootprintTable(const std::string& bytes, const std::string& name, const KernelShape& kernel) {
     const ParsedFile p = splitFile(bytes, name);
-    verifyIdentity(p, "footprint");
+    verifyIdentity(p, "footprint", kernel);
     const int n = intervalCount(p, p.number("intervals"));
     if (p.get("index") != "d2" || p.get("domain") != "0 1") p.fail("footprint table: unsupported index or domain");
     std::vector<float> v = verifyPayload(p, static_cast<size_t>(n) + 1);
@@ -320,7 +321,7 @@ FootprintTable parseFootprintTable(const std::string& bytes, const std::string& 
 
 ReindexTable parseReindexTable(const std::string& bytes, const std::string& name) {
     const ParsedFile p = splitFile(bytes, name);
-    verifyIdentity(p, "reindex");
+    verifyIdentity(p, "reindex", KernelShape::standard());
     const std::vector<double> n = p.numbers("intervals", 2);
     const int nI2 = intervalCount(p, n[0]), nAlpha = intervalCount(p, n[1]);
     if (p.get("domain_i2") != "0 1") p.fail("reindex table: unsupported i2 domain");
@@ -330,7 +331,15 @@ ReindexTable parseReindexTable(const std::string& bytes, const std::string& name
     return ReindexTable(std::move(v), nI2, nAlpha, dom[1], p.number("max_abs_error"), p.number("error_bound"));
 }
 
-Tables buildTables() { return {FootprintTable::build(), ReindexTable::build(), FootprintPolynomials::build()}; }
+std::string footprintTableFile(const KernelShape& kernel) {
+    if (&kernel == &KernelShape::standard()) return kFootprintTableFile;
+    return std::string("footprint-") + kernel.id() + ".table";
+}
+
+Tables buildTables(const KernelShape& kernel) {
+    return {FootprintTable::build(FootprintTable::kIntervals, kernel), ReindexTable::build(),
+            FootprintPolynomials::build(kernel), &kernel};
+}
 
 std::filesystem::path defaultTablesDir() { return std::filesystem::path(VDBSPLAT_SOURCE_DIR) / "tables"; }
 
@@ -338,47 +347,53 @@ void saveTables(const Tables& tables, const std::filesystem::path& dir) {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) throw Error(dir.string() + ": cannot create directory (" + ec.message() + ")");
-    writeFile(dir / kFootprintTableFile, serializeFootprintTable(tables.footprint));
+    writeFile(dir / footprintTableFile(*tables.kernel), serializeFootprintTable(tables.footprint, *tables.kernel));
     writeFile(dir / kReindexTableFile, serializeReindexTable(tables.reindex));
 }
 
-Tables loadTables(const std::filesystem::path& dir) {
-    const std::filesystem::path fp = dir / kFootprintTableFile, ri = dir / kReindexTableFile;
-    return {parseFootprintTable(readFile(fp), fp.string()), parseReindexTable(readFile(ri), ri.string()),
-            FootprintPolynomials::build()};
+Tables loadTables(const std::filesystem::path& dir, const KernelShape& kernel) {
+    const std::filesystem::path fp = dir / footprintTableFile(kernel), ri = dir / kReindexTableFile;
+    return {parseFootprintTable(readFile(fp), fp.string(), kernel), parseReindexTable(readFile(ri), ri.string()),
+            FootprintPolynomials::build(kernel), &kernel};
 }
 
-Tables loadOrBuildTables(const std::filesystem::path& dir) {
-    const std::filesystem::path fp = dir / kFootprintTableFile, ri = dir / kReindexTableFile;
+Tables loadOrBuildTables(const std::filesystem::path& dir, const KernelShape& kernel) {
+    const std::filesystem::path fp = dir / footprintTableFile(kernel), ri = dir / kReindexTableFile;
     Tables t;
-    t.footprint = std::filesystem::exists(fp) ? parseFootprintTable(readFile(fp), fp.string()) : FootprintTable::build();
+    t.footprint = std::filesystem::exists(fp) ? parseFootprintTable(readFile(fp), fp.string(), kernel)
+                                              : FootprintTable::build(FootprintTable::kIntervals, kernel);
     t.reindex = std::filesystem::exists(ri) ? parseReindexTable(readFile(ri), ri.string()) : ReindexTable::build();
-    t.poly = FootprintPolynomials::build();
+    t.poly = FootprintPolynomials::build(kernel);
+    t.kernel = &kernel;
     return t;
 }
 
 std::vector<std::string> checkTables(const std::filesystem::path& dir) {
-    const Tables fresh = buildTables();
-    const std::pair<const char*, std::string> files[] = {
-        {kFootprintTableFile, serializeFootprintTable(fresh.footprint)},
-        {kReindexTableFile, serializeReindexTable(fresh.reindex)}};
-    const Tables loaded = loadTables(dir);  // parse + checksum + kernel identity first
-    (void)loaded;
     std::vector<std::string> summary;
-    for (const auto& [file, expected] : files) {
-        const std::filesystem::path path = dir / file;
-        const std::string actual = readFile(path);
-        if (actual != expected) {
-            size_t at = 0;
-            while (at < actual.size() && at < expected.size() && actual[at] == expected[at]) ++at;
-            throw Error(path.string() + ": differs from a fresh build at byte " + std::to_string(at) + " (" +
-                        std::to_string(actual.size()) + " vs " + std::to_string(expected.size()) +
-                        " bytes); regenerate with `vdbsplat tables --out DIR`");
+    // The reindex table once, then each kernel's footprint table (tables.h: footprintTableFile).
+    const KernelShape* kernels[] = {&KernelShape::standard(), &KernelShape::sharp()};
+    for (const KernelShape* kernel : kernels) {
+        const Tables fresh = buildTables(*kernel);
+        std::vector<std::tuple<std::string, std::string, double>> files = {
+            {footprintTableFile(*kernel), serializeFootprintTable(fresh.footprint, *kernel), fresh.footprint.maxAbsError()}};
+        if (kernel == kernels[0])
+            files.insert(files.begin() + 1, {kReindexTableFile, serializeReindexTable(fresh.reindex), fresh.reindex.maxAbsError()});
+        const Tables loaded = loadTables(dir, *kernel);  // parse + checksum + kernel identity first
+        (void)loaded;
+        for (const auto& [file, expected, error] : files) {
+            const std::filesystem::path path = dir / file;
+            const std::string actual = readFile(path);
+            if (actual != expected) {
+                size_t at = 0;
+                while (at < actual.size() && at < expected.size() && actual[at] == expected[at]) ++at;
+                throw Error(path.string() + ": differs from a fresh build at byte " + std::to_string(at) + " (" +
+                            std::to_string(actual.size()) + " vs " + std::to_string(expected.size()) +
+                            " bytes); regenerate with `vdbsplat tables --out DIR`");
+            }
+            summary.push_back(path.string() + ": ok (" + std::to_string(actual.size()) +
+                              " bytes, matches a fresh build), max error " + fmt("%.3e", error));
         }
-        summary.push_back(path.string() + ": ok (" + std::to_string(actual.size()) + " bytes, matches a fresh build)");
     }
-    summary[0] += ", max error " + fmt("%.3e", fresh.footprint.maxAbsError());
-    summary[1] += ", max error " + fmt("%.3e", fresh.reindex.maxAbsError());
     return summary;
 }
 

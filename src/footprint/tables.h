@@ -15,11 +15,16 @@
 #include <vector>
 
 #include "footprint/footprint_poly.h"
+#include "footprint/kernel.h"
 
 namespace vdbsplat {
 
 inline constexpr int kTableFormatVersion = 1;              ///< bump when the file layout changes
-inline constexpr const char* kFootprintTableFile = "footprint.table";
+inline constexpr const char* kFootprintTableFile = "footprint.table";  ///< the standard kernel's
+/// @brief The footprint table's file name for @p kernel: kFootprintTableFile for the standard
+/// kernel, "footprint-<id>.table" for the others (the reindex table is the kernel's geometry only,
+/// one file for all).
+std::string footprintTableFile(const KernelShape& kernel);
 inline constexpr const char* kReindexTableFile = "reindex.table";
 
 /// @brief F as a function of d² ∈ [0, 1], uniformly sampled in d² (F in voxel units,
@@ -28,8 +33,8 @@ class FootprintTable {
 public:
     static constexpr int kIntervals = 4096;  ///< 16 KiB of floats: stays in L1/L2
 
-    /// @brief The table built from Kernel::footprint (deterministic).
-    static FootprintTable build(int intervals = kIntervals);
+    /// @brief The table built from @p kernel's closed-form footprint (deterministic).
+    static FootprintTable build(int intervals = kIntervals, const KernelShape& kernel = KernelShape::standard());
 
     /// @brief F at normalised squared distance @p d2 (linear interpolation); 0 for
     /// d2 ≥ 1 or NaN, F(0) for d2 < 0.
@@ -122,30 +127,32 @@ struct Tables {
     FootprintTable footprint;
     ReindexTable reindex;
     FootprintPolynomials poly;
+    const KernelShape* kernel = &KernelShape::standard();  ///< the kernel footprint and poly were built for
 };
 
 /// @brief Max |lookup − closed form| of @p t over a dense deterministic sampling
 /// (16 samples per interval, both ends included); the float lookup path is measured.
-double measureFootprintError(const FootprintTable& t);
+double measureFootprintError(const FootprintTable& t, const KernelShape& kernel = KernelShape::standard());
 /// @brief Max |d² lookup − reindex2| over 8×8 samples per cell of the α range.
 double measureReindexError(const ReindexTable& t);
 
 /// @brief Builds both tables in memory (deterministic, ≈ 50 ms).
-Tables buildTables();
+Tables buildTables(const KernelShape& kernel = KernelShape::standard());
 
 /// @brief The directory of the shipped tables: VDBSPLAT_SOURCE_DIR "/tables".
 std::filesystem::path defaultTablesDir();
 
 /// @brief The exact bytes of a table file (header + payload); what save() writes and
 /// `vdbsplat tables --check` compares against.
-std::string serializeFootprintTable(const FootprintTable& t);
+std::string serializeFootprintTable(const FootprintTable& t, const KernelShape& kernel = KernelShape::standard());
 std::string serializeReindexTable(const ReindexTable& t);
 
 /// @brief Parses and verifies a table file's bytes. @p name is used in messages.
 /// @throw Error naming @p name: bad magic, wrong format version, wrong table kind, a
 /// table built for another kernel (name, s_g or R), bad sizes, truncated or oversized
 /// payload, checksum mismatch.
-FootprintTable parseFootprintTable(const std::string& bytes, const std::string& name);
+FootprintTable parseFootprintTable(const std::string& bytes, const std::string& name,
+                                   const KernelShape& kernel = KernelShape::standard());
 ReindexTable parseReindexTable(const std::string& bytes, const std::string& name);
 
 /// @brief Writes footprint.table and reindex.table into @p dir (created if needed).
@@ -154,13 +161,14 @@ void saveTables(const Tables& tables, const std::filesystem::path& dir);
 
 /// @brief Loads and verifies both files from @p dir.
 /// @throw Error naming the file: missing, unreadable, or any parse failure above.
-Tables loadTables(const std::filesystem::path& dir);
+Tables loadTables(const std::filesystem::path& dir, const KernelShape& kernel = KernelShape::standard());
 
 /// @brief The renderer's entry point. For each table: if its file in @p dir is ABSENT,
 /// build it in memory (a source tree without tables/ still renders); if it is present,
 /// load and verify it and REFUSE (throw) when it is corrupt or from another kernel —
 /// a damaged shipped table is never silently replaced.
-Tables loadOrBuildTables(const std::filesystem::path& dir = defaultTablesDir());
+Tables loadOrBuildTables(const std::filesystem::path& dir = defaultTablesDir(),
+                         const KernelShape& kernel = KernelShape::standard());
 
 /// @brief Verifies the files in @p dir (parse + checksum) and that they are byte for byte
 /// what buildTables() + serialize produce now. @return a one-line summary per table.

@@ -10,8 +10,8 @@
 
 namespace vdbsplat {
 
-double pointFilterVariance(double projectedSpacingPx, double prefilterVariance) {
-    const double s = Kernel::kSigma * projectedSpacingPx;
+double pointFilterVariance(double projectedSpacingPx, double prefilterVariance, double kernelSigma) {
+    const double s = kernelSigma * projectedSpacingPx;
     return prefilterVariance + s * s;
 }
 

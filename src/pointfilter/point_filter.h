@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "camera/camera.h"
+#include "footprint/kernel.h"
 #include "footprint/prefilter.h"
 
 namespace vdbsplat {
@@ -31,7 +32,9 @@ inline constexpr int kPointMaxSide = 7;             ///< 2·kPointMaxRadiusPx
 /// @brief V_point = kPrefilterVariance + (s_g·@p projectedSpacingPx)² in px², where the
 /// projected voxel spacing is h·f/z pixels (DESIGN §4).
 /// @param prefilterVariance the low-pass V_h in px² (the postfilter order passes a smaller one).
-double pointFilterVariance(double projectedSpacingPx, double prefilterVariance = kPrefilterVariance);
+/// @param kernelSigma the reconstruction kernel's s_g (voxels; the standard kernel's by default).
+double pointFilterVariance(double projectedSpacingPx, double prefilterVariance = kPrefilterVariance,
+                           double kernelSigma = Kernel::kSigma);
 
 /// @brief The point's total optical depth summed over pixels (DESIGN §4):
 ///     σ · M · (f/z)² · (D/z),   M = h³ (the kernel's volume integral in world units).

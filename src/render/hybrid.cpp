@@ -64,14 +64,14 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     StreamOptions streamOptions = settings.stream;
     streamOptions.lodCellPx = pass.lodPx;
     streamOptions.pointPrefilterVariance = pass.prefilterVariance;
-    streamOptions.pointBelowPx = settings.mode == RenderMode::Point   ? INFINITY
-                                 : settings.mode == RenderMode::Splat ? 0.0
-                                                                      : pass.threshold;
+    streamOptions.pointBelowPx = settings.mode == RenderMode::Point ? INFINITY
+                                 : drawsOnlySplats(settings.mode)   ? 0.0
+                                                                    : pass.threshold;
     VoxelStream stream(volume, camera, table, streamOptions, shader, emission);
     // The kernels' shape in view space (anisotropic or sheared voxels: ellipsoids).
     // view = R·(world − eye), R's rows right, up, forward: M = R·A.
     const glm::dmat3 worldToView = glm::transpose(glm::dmat3(camera.right(), camera.up(), camera.forward()));
-    KernelShape shape = KernelShape::of(worldToView * glm::dmat3(volume.indexToWorld));
+    VoxelShape shape = VoxelShape::of(worldToView * glm::dmat3(volume.indexToWorld));
     shape.sphere = volume.isotropic;
     ExactContext exact{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance};
     exact.shape = &shape;
@@ -119,8 +119,8 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
 /// How far (px) past the projection of a primitive's kernel sphere its deposits reach: a point's
 /// filter r_s ≤ kPointMaxRadiusPx (pointfilter/point_filter.h); a splat's support ellipse
 /// widened by V (screen_kernel.cpp: a' = √(a² + (R/s_g)²·V) ≤ a + (R/s_g)·√V); one pixel to spare.
-double depositReachPx(double prefilterVariance) {
-    return std::max(kPointMaxRadiusPx, Kernel::kRadius / Kernel::kSigma * std::sqrt(prefilterVariance)) + 1.0;
+double depositReachPx(double prefilterVariance, const KernelShape& kernel) {
+    return std::max(kPointMaxRadiusPx, kernel.radius() / kernel.sigma() * std::sqrt(prefilterVariance)) + 1.0;
 }
 
 /// The pixels of @p camera any primitive of @p volume can touch, grown by @p grow pixels: the
@@ -168,9 +168,12 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     // Fixed costs follow the pixels the volume covers, not the image: the compositor, its
     // tiles and the postfilter see only that rectangle (a cropped camera: the same rays, so the
     // same image there, up to the float rounding of pixel coordinates); the rest is empty.
-    if (settings.filterOrder == FilterOrder::Prefilter) {
-        const ForwardPass pass{settings.threshold, settings.lodPx, kPrefilterVariance};
-        const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance), 0);
+    // Ewa and Swan fold V_h into each primitive by definition (the prefilter order); None has no
+    // low-pass at all, and no level of detail (an aggregate is a prefiltered point).
+    if (settings.filterOrder == FilterOrder::Prefilter || modeFixesFilterOrder(settings.mode)) {
+        const bool none = settings.mode == RenderMode::None;
+        const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, none ? 0.0 : kPrefilterVariance};
+        const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, *tables.kernel), 0);
         if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control, emission);
         const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
         const Image part = composite(volume, table, camera.cropped(crop->x0, crop->y0, w, h), tables, settings, pass,
@@ -188,7 +191,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     // pixels they reach through the filter lie within `border` more; the crop of the sub-pixel
     // image is that output rectangle with its own border, as subpixelCamera frames the whole image.
     const std::optional<PixelRange> crop =
-        coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance), grid.border);
+        coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, *tables.kernel), grid.border);
     if (!crop) {
         const Image sub = composite(volume, table, fine, tables, settings, pass, stats, shader, control, emission);
         return postfilterImage(sub, grid, camera.width(), camera.height());

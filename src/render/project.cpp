@@ -11,6 +11,7 @@
 #include "footprint/kernel.h"
 #include "footprint/screen_kernel.h"
 #include "pointfilter/point_filter.h"
+#include "render/project_modes.h"
 
 namespace vdbsplat {
 
@@ -35,7 +36,7 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float sp
     if (!std::isfinite(centre.x) || !std::isfinite(centre.y)) return p;
     p.kind = PrimitiveKind::Point;
     p.centre = glm::vec2(centre);
-    p.variance = float(pointFilterVariance(spacingPx, ctx.prefilterVariance) + spreadPx2);  // + an aggregate's spread (DESIGN §8.2)
+    p.variance = float(pointFilterVariance(spacingPx, ctx.prefilterVariance, ctx.tables.kernel->sigma()) + spreadPx2);  // + an aggregate's spread (DESIGN §8.2)
     // σ·M·(f/z)²·(D/z) with σ per world unit = sigma / h (DESIGN §4).
     p.total = float(pointDepositTotal(sigma / ctx.voxelSize, ctx.voxelSize, ctx.camera.focal(), c));
     PixelBox box;
@@ -46,10 +47,10 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float sp
     return p;
 }
 
-Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& ctx) {
+Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, const ProjectionContext& ctx) {
     Primitive p;
     const double h = ctx.voxelSize;
-    const SphereProjection sphere = projectSphere(ctx.camera, c, Kernel::kRadius * h);
+    const SphereProjection sphere = projectSphere(ctx.camera, c, ctx.tables.kernel->radius() * h);
     p.viewPos = glm::vec3(c);
     p.sigma = sigma;
     switch (sphere.kind) {
@@ -60,8 +61,13 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
             p.range = pixelRange(sphere.bounds, ctx.camera.width(), ctx.camera.height());
             break;
         case SphereClass::Ellipse: {
-            const ScreenKernel kernel = makeScreenKernel(sphere, ctx.prefilterVariance);
-            p.kind = ctx.footprint == FootprintPath::Exact ? PrimitiveKind::SplatExact
+            if (ctx.mode == RenderMode::Ewa) {  // Zwicker et al. 2001: the affine kernel (project_modes.h)
+                fillEwaSplat(p, c, sigma, ctx);
+                break;
+            }
+            const ScreenKernel kernel = splatKernelFor(sphere, spacingPx, ctx);  // Swan's stretch or V + V_h
+            p.kind = keepsTablePath(spacingPx, ctx)            ? PrimitiveKind::Splat
+                     : ctx.footprint == FootprintPath::Exact ? PrimitiveKind::SplatExact
                      : ctx.footprint == FootprintPath::Auto && sphere.affineIndexError() > kAutoExactIndexError
                          ? PrimitiveKind::SplatExactIndex
                          : PrimitiveKind::Splat;
@@ -88,7 +94,7 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
 /// docs/kernel.md, "Any voxel shape"); kernels at the eye take the exact half-ray integral.
 Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, const ProjectionContext& ctx) {
     Primitive p;
-    const KernelShape& shape = *ctx.shape;
+    const VoxelShape& shape = *ctx.shape;
     const EllipsoidProjection e = projectEllipsoid(shape, c, ctx.camera.focal(), ctx.camera.principal());
     p.viewPos = glm::vec3(c);
     p.sigma = sigma;
@@ -124,13 +130,16 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
     // The projected voxel spacing h·f/z; for an ellipsoid its longest axis (a splat as soon as any
     // axis is magnified) decides, and its projected spacing sets the point filter.
     const double spacingPx = c.z > 0.0 ? (ellipsoid ? ctx.shape->sMax : ctx.voxelSize) * ctx.camera.focal() / c.z : INFINITY;
+    // Hybrid and None switch on the threshold; Splat, Ewa and Swan draw every voxel as a splat.
     const bool point = ctx.mode == RenderMode::Point ? c.z > 0.0
-                       : ctx.mode == RenderMode::Splat ? false
-                                                       : spacingPx < ctx.threshold;
+                       : drawsOnlySplats(ctx.mode) ? false
+                                                   : spacingPx < ctx.threshold;
     const double filterPx = ellipsoid && c.z > 0.0 ? ctx.shape->projectedSpacing() * ctx.camera.focal() / c.z : spacingPx;
     Primitive p = point       ? makePoint(c, sigma, filterPx, spreadPx2, ctx)
                   : ellipsoid ? makeEllipsoidSplat(c, sigma, ctx)
-                              : makeSplat(c, sigma, ctx);
+                              : makeSplat(c, sigma, spacingPx, ctx);
+    if (point && ctx.mode == RenderMode::None && p.kind == PrimitiveKind::Point)
+        snapToNearestPixel(p, ctx.camera.width(), ctx.camera.height());
     p.color = (!point && ctx.showPrimitives) ? splatTint(color) : color;
     return p;
 }

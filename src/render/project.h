@@ -39,7 +39,7 @@ struct ProjectionContext {
     /// paths. An ellipsoid (anisotropic or sheared voxels) decides point/splat by its longest
     /// axis, filters points with its projected spacing, and is splatted through its exact
     /// silhouette and the exact index-space distance (SplatExactIndex; --footprint does not apply).
-    const KernelShape* shape = nullptr;
+    const VoxelShape* shape = nullptr;
 };
 
 /// @brief Projects every voxel of @p batch into the first batch.size() elements of @p prims

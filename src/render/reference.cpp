@@ -13,6 +13,8 @@
 #include <map>
 #include <numbers>
 
+#include <stdexcept>
+
 #include "footprint/kernel.h"
 #include "footprint/prefilter.h"
 #include "util/error.h"
@@ -21,19 +23,19 @@ namespace vdbsplat {
 
 namespace {
 
+/// The largest kernel radius (KernelShape radii are ≤ Kernel::kRadius): the ray's reach bounds.
 constexpr double kR = Kernel::kRadius;
-constexpr double kS = Kernel::kSigma;
 /// Ring of depth bins; must exceed the span of unfinished bins, 2(W + R) + √3 ≤ 16 voxels = 64 bins.
 constexpr int kRingSize = 256;
 
 /// E(u) = erf(u / (s√2)) for u ∈ [−R, R], tabulated: the kernel's line-integral primitive.
 class ErfTable {
 public:
-    ErfTable() {
-        for (int k = 0; k < kN; ++k) values_[k] = std::erf((-kR + k * kStep) / (kS * std::numbers::sqrt2));
+    ErfTable(double s, double R) : R_(R), step_(2.0 * R / (kN - 1)) {
+        for (int k = 0; k < kN; ++k) values_[k] = std::erf((-R + k * step_) / (s * std::numbers::sqrt2));
     }
     double operator()(double u) const {
-        const double x = std::clamp((u + kR) / kStep, 0.0, double(kN - 1));
+        const double x = std::clamp((u + R_) / step_, 0.0, double(kN - 1));
         const int k = std::min(int(x), kN - 2);
         const double t = x - k;
         return values_[k] + t * (values_[k + 1] - values_[k]);
@@ -41,13 +43,17 @@ public:
 
 private:
     static constexpr int kN = 4097;
-    static constexpr double kStep = 2.0 * kR / (kN - 1);
+    double R_, step_;
     std::array<double, kN> values_;
 };
 
-const ErfTable& erfTable() {
-    static const ErfTable table;  // immutable after construction
-    return table;
+/// The table of @p kernel (one of KernelShape's kernels; immutable after construction).
+const ErfTable& erfTable(const KernelShape& kernel) {
+    static const ErfTable standard(KernelShape::standard().sigma(), KernelShape::standard().radius());
+    static const ErfTable sharp(KernelShape::sharp().sigma(), KernelShape::sharp().radius());
+    if (&kernel == &KernelShape::sharp()) return sharp;
+    if (&kernel != &KernelShape::standard()) throw std::invalid_argument("reference: kernel without an erf table");
+    return standard;
 }
 
 /// Deterministic hash of three integers to [0, 1) (splitmix64 finaliser).
@@ -116,8 +122,9 @@ ActiveRegions::ActiveRegions(const openvdb::FloatGrid& grid) {
 }
 
 RayIntegrator::RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions,
-                             const ShadingField* shading, const EmissionSource* emission)
-    : volume_(volume), table_(table), accessor_(volume.grid->getConstAccessor()),
+                             const ShadingField* shading, const EmissionSource* emission, const KernelShape& kernel)
+    : volume_(volume), table_(table), kernel_(kernel), kernelR2_(kernel.radius() * kernel.radius()),
+      accessor_(volume.grid->getConstAccessor()),
       shading_(shading ? std::make_unique<ShadingField::Accessor>(shading->tree()) : nullptr),
       emission_(emission),
       emissionAccessor_(emission ? std::make_unique<EmissionSource::Accessor>(emission->accessor()) : nullptr),
@@ -215,7 +222,7 @@ void RayIntegrator::gather(const glm::dvec3& o, const glm::dvec3& d, double tEnt
                     const glm::dvec3 w = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) - o;
                     const double tc = glm::dot(w, d);
                     const double rho2 = glm::dot(w, w) - tc * tc;
-                    if (rho2 >= kR * kR) continue;
+                    if (rho2 >= kernelR2_) continue;
                     float value;
                     if (!accessor_.probeValue(ijk, value)) continue;
                     visit.kernel(tc, rho2, classify(ijk, value));
@@ -244,6 +251,7 @@ struct BinCompositor {
     double tEnter;
     /// World length per index length along the ray, over h (rayStretch): 1 for cubic voxels.
     double stretch = 1.0;
+    const KernelShape& shape;
     glm::dvec3 color{0.0};
     double transmittance = 1.0;
     int64_t next = 0;     // first bin not yet composited
@@ -266,13 +274,14 @@ struct BinCompositor {
     /// Deposits one kernel's exact line integral, bin by bin: τ_bin = σ_k ∫_bin g dt (erf).
     void kernel(double tc, double rho2, const Classified& cls) {
         if (!(cls.sigma > 0.f)) return;
-        const ErfTable& E = erfTable();
-        const double halfChord = std::sqrt(kR * kR - rho2);
+        const ErfTable& E = erfTable(shape);
+        const double R = shape.radius(), s = shape.sigma();
+        const double halfChord = std::sqrt(R * R - rho2);
         const double tStart = std::max(tc - halfChord, tEnter), tEnd = tc + halfChord;
         if (tEnd <= tStart) return;
         // ∫ N e^{−(ρ²+u²)/2s²} du = N e^{−ρ²/2s²} · s√(π/2) · ΔE(u)
-        const double amplitude = stretch * cls.sigma * Kernel::normalization() * kS * std::sqrt(std::numbers::pi / 2.0) *
-                                 std::exp(-rho2 / (2.0 * kS * kS));
+        const double amplitude = stretch * cls.sigma * shape.normalization() * s * std::sqrt(std::numbers::pi / 2.0) *
+                                 std::exp(-rho2 / (2.0 * s * s));
         const glm::dvec3 c(cls.color);
         int64_t j = binOf(tStart);
         const int64_t jEnd = binOf(tEnd);
@@ -316,7 +325,7 @@ glm::dvec4 RayIntegrator::integrate(const glm::dvec3& origin, const glm::dvec3& 
     double tEnter, tExit;
     if (!clip(o, d, tEnter, tExit)) return glm::dvec4(0.0);
     std::fill(bins_.begin(), bins_.end(), Bin{});
-    BinCompositor compositor{bins_, tEnter, rayStretch(volume_, direction)};
+    BinCompositor compositor{bins_, tEnter, rayStretch(volume_, direction), kernel_};
     gather(o, d, tEnter, tExit, compositor);
     compositor.compositeUpTo(compositor.filled + 1);
     return glm::dvec4(compositor.color, 1.0 - compositor.transmittance);
@@ -331,7 +340,7 @@ double RayIntegrator::opticalDepth(const glm::dvec3& origin, const glm::dvec3& d
         RayIntegrator* self;
         double tEnter, stretch, sum = 0.0;
         void kernel(double tc, double rho2, const Classified& cls) {
-            sum += stretch * cls.sigma * Kernel::segmentIntegral(std::sqrt(rho2), tEnter - tc, kR);
+            sum += stretch * cls.sigma * self->kernel_.segmentIntegral(std::sqrt(std::max(rho2, 0.0)), tEnter - tc, self->kernel_.radius());
         }
         bool sliceDone(double) { return true; }
     } visitor{this, tEnter, rayStretch(volume_, direction)};
@@ -341,7 +350,7 @@ double RayIntegrator::opticalDepth(const glm::dvec3& origin, const glm::dvec3& d
 
 Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
                       RenderStats& stats, const ShadingField* shading, const RenderControl& control,
-                      const EmissionSource* emission) {
+                      const EmissionSource* emission, const KernelShape& kernel) {
     const auto start = std::chrono::steady_clock::now();
     const int n = std::max(1, int(std::ceil(std::sqrt(double(spp)) - 1e-9)));  // strata per axis
     stats.raysPerPixel = n * n;
@@ -373,7 +382,7 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
             return PixelCoord(px + (sx + hash01(px, py, 2 * s)) / n, py + (sy + hash01(px, py, 2 * s + 1)) / n);
         };
         tbb::parallel_for(tbb::blocked_range<int>(0, sh, 1), [&](const tbb::blocked_range<int>& rows) {
-            RayIntegrator integrator(volume, table, &regions, shading, emission);
+            RayIntegrator integrator(volume, table, &regions, shading, emission, kernel);
             for (int r = rows.begin(); r < rows.end(); ++r) {
                 if (stopped.load(std::memory_order_relaxed) || (control.stop && control.stop())) {
                     stopped.store(true);

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "camera/camera.h"
+#include "footprint/kernel.h"
 #include "image/image.h"
 #include "render/settings.h"
 #include "shading/shading_field.h"
@@ -56,8 +57,10 @@ public:
     /// null the integrator builds its own.
     /// @p shading: per-voxel shading factors applied after classification (nullptr: none).
     /// @p emission: each voxel's emission, added after shading (nullptr: none; docs/emission.md).
+    /// @p kernel: the reconstruction kernel integrated (--kernel; the standard one by default).
     RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions = nullptr,
-                  const ShadingField* shading = nullptr, const EmissionSource* emission = nullptr);
+                  const ShadingField* shading = nullptr, const EmissionSource* emission = nullptr,
+                  const KernelShape& kernel = KernelShape::standard());
     /// @brief Premultiplied RGB and alpha = 1 − T of the ray from world point @p origin
     /// along world direction @p direction (any length), from the origin to infinity.
     glm::dvec4 integrate(const glm::dvec3& origin, const glm::dvec3& direction);
@@ -82,6 +85,8 @@ private:
 
     const Volume& volume_;
     const ClassificationTable& table_;
+    const KernelShape& kernel_;
+    double kernelR2_;  ///< R² of kernel_ (voxel units²)
     openvdb::FloatGrid::ConstAccessor accessor_;
     std::unique_ptr<ShadingField::Accessor> shading_;  ///< null when unshaded
     const EmissionSource* emission_;
@@ -101,6 +106,7 @@ private:
 /// @param emission each voxel's emission (nullptr: none), as RayIntegrator.
 Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
                       RenderStats& stats, const ShadingField* shading = nullptr,
-                      const RenderControl& control = {}, const EmissionSource* emission = nullptr);
+                      const RenderControl& control = {}, const EmissionSource* emission = nullptr,
+                      const KernelShape& kernel = KernelShape::standard());
 
 }  // namespace vdbsplat

@@ -47,6 +47,18 @@ void checkEyeDistance(const CameraSpec& spec, const glm::dvec3& lo, const glm::d
     }
 }
 
+/// Ellipsoid kernels (non-cubic or sheared voxels, docs/kernel.md §10) are projected exactly for
+/// the standard kernel; the study's affine EWA and Swan footprints and the second kernel are
+/// defined for spheres only, so those combinations are refused rather than drawn as something else.
+void checkKernelShape(const Volume& volume, const RenderSettings& settings) {
+    if (volume.isotropic) return;
+    const std::string where = volume.file + ": grid '" + volume.name + "' has non-cubic or sheared voxels";
+    if (settings.mode == RenderMode::Ewa || settings.mode == RenderMode::Swan)
+        throw Error("--mode " + toString(settings.mode) + ": " + where + ", which it does not support (use hybrid, splat, point, none or reference)");
+    if (&KernelShape::named(settings.kernel) != &KernelShape::standard())
+        throw Error("--kernel " + settings.kernel + ": " + where + ", which only the standard kernel supports");
+}
+
 Camera cameraFor(const Volume& volume, const RenderSettings& settings) {
     glm::dvec3 lo, hi;
     volume.worldBounds(lo, hi);
@@ -59,6 +71,7 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     const auto start = std::chrono::steady_clock::now();
     if (control.stop && control.stop()) throw RenderStopped("render stopped before it began");
     checkVoxelBudget(volume, settings);
+    checkKernelShape(volume, settings);
     float lo, hi;
     normalizationRange(volume, lo, hi);
     const ClassificationTable table = tf.bake(lo, hi, volume.voxelSize);
@@ -81,14 +94,19 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
                 field = std::make_unique<ShadingField>(*shader);
                 stats.shadingSeconds = field->seconds();
             }
-            image = renderReference(volume, table, camera, settings.spp, stats, field.get(), control, emission.get());
+            image = renderReference(volume, table, camera, settings.spp, stats, field.get(), control, emission.get(),
+                                    KernelShape::named(settings.kernel));
             break;
         }
         case RenderMode::Hybrid:
         case RenderMode::Splat:
-        case RenderMode::Point: {
+        case RenderMode::Point:
+        case RenderMode::Ewa:
+        case RenderMode::Swan:
+        case RenderMode::None: {
             const Tables tables =
-                loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir));
+                loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir),
+                                  KernelShape::named(settings.kernel));
             image = renderForward(volume, table, camera, tables, settings, stats, shader.get(), control, emission.get());
             break;
         }

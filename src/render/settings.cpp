@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "footprint/kernel.h"
 #include "util/error.h"
 
 namespace vdbsplat {
@@ -12,8 +13,11 @@ RenderMode parseRenderMode(const std::string& name) {
     if (name == "hybrid") return RenderMode::Hybrid;
     if (name == "splat") return RenderMode::Splat;
     if (name == "point") return RenderMode::Point;
+    if (name == "ewa") return RenderMode::Ewa;
+    if (name == "swan") return RenderMode::Swan;
+    if (name == "none") return RenderMode::None;
     if (name == "reference") return RenderMode::Reference;
-    throw Error("--mode: unknown mode '" + name + "' (choose hybrid, splat, point, reference)");
+    throw Error("--mode: unknown mode '" + name + "' (choose " + kRenderModeNames + ")");
 }
 
 std::string toString(RenderMode mode) {
@@ -21,9 +25,20 @@ std::string toString(RenderMode mode) {
         case RenderMode::Hybrid: return "hybrid";
         case RenderMode::Splat: return "splat";
         case RenderMode::Point: return "point";
+        case RenderMode::Ewa: return "ewa";
+        case RenderMode::Swan: return "swan";
+        case RenderMode::None: return "none";
         case RenderMode::Reference: return "reference";
     }
     return "?";
+}
+
+bool drawsOnlySplats(RenderMode mode) {
+    return mode == RenderMode::Splat || mode == RenderMode::Ewa || mode == RenderMode::Swan;
+}
+
+bool modeFixesFilterOrder(RenderMode mode) {
+    return mode == RenderMode::Ewa || mode == RenderMode::Swan || mode == RenderMode::None;
 }
 
 void RenderSettings::validate() const {
@@ -44,6 +59,7 @@ void RenderSettings::validate() const {
         throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
     shading.validate();
     emission.validate();
+    (void)KernelShape::named(kernel);  // throws "--kernel: unknown kernel ..."
     if (!tablesDir.empty()) {
         std::error_code ec;
         if (!std::filesystem::is_directory(tablesDir, ec))
@@ -98,10 +114,12 @@ nlohmann::json RenderSettings::toJson() const {
     j["spp"] = spp;
     j["threshold"] = threshold;
     j["footprint"] = toString(footprint);
-    j["filter_order"] = toString(filterOrder);
-    j["subpixels"] = subpixels;
+    j["kernel"] = kernel;
+    // Ewa and Swan filter each primitive, None filters nothing (RenderMode): echo what was used.
+    j["filter_order"] = mode == RenderMode::None ? "none" : modeFixesFilterOrder(mode) ? "prefilter" : toString(filterOrder);
+    j["subpixels"] = modeFixesFilterOrder(mode) ? 1 : subpixels;
     j["show_primitives"] = showPrimitives;
-    j["lod"] = lodPx;
+    j["lod"] = mode == RenderMode::None ? 0.0 : lodPx;
     j["simd"] = simd;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
     if (shading.active()) j["shading"] = shading.toJson();  // absent when off: unshaded outputs unchanged

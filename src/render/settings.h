@@ -15,7 +15,16 @@
 
 namespace vdbsplat {
 
-enum class RenderMode { Reference, Hybrid, Splat, Point };
+/// Reference: the ray integrator (ground truth). Hybrid, Splat, Point: Yuan et al. 2003 with the
+/// EWA low-pass on the exact perspective ellipse. The study modes (DESIGN §6, docs/modes.md):
+///   Ewa  — Zwicker et al. 2001: every voxel a splat from the local affine approximation of the
+///          projection (Jacobian at the voxel centre) plus V_h (footprint/ewa.h);
+///   Swan — Swan et al. 1997: minified voxels' footprints stretched uniformly to the pixel
+///          filter's size, energy kept (footprint/swan.h); magnified voxels as hybrid splats;
+///   None — no low-pass: splats without V_h, points to the nearest pixel (the aliasing baseline).
+/// Ewa and Swan fold the low-pass into each primitive (the prefilter order) by definition, None
+/// has none: the three ignore --filter-order and --subpixels, and None turns --lod off.
+enum class RenderMode { Reference, Hybrid, Splat, Point, Ewa, Swan, None };
 /// How a splat's footprint index is found (DESIGN §3, docs/footprint.md):
 ///   Table — affine ellipse→circle index i, then the (i, α) reindex table (the seed's method);
 ///   Auto  — Table, except splats whose affine-index error tanθ·tanα exceeds
@@ -47,9 +56,16 @@ inline constexpr int kDefaultSubpixels = 1, kMaxSubpixels = 8;
 FootprintPath parseFootprintPath(const std::string& name);
 std::string toString(FootprintPath path);
 
-/// @throw Error "unknown mode '<name>' (choose hybrid, splat, point, reference)".
+/// The --mode names, in the order --help and the error text list them.
+inline constexpr const char* kRenderModeNames = "hybrid, splat, point, ewa, swan, none, reference";
+
+/// @throw Error "--mode: unknown mode '<name>' (choose hybrid, splat, point, ewa, swan, none, reference)".
 RenderMode parseRenderMode(const std::string& name);
 std::string toString(RenderMode mode);
+/// True for the modes that fix where the low-pass goes (Ewa, Swan: in each primitive; None: nowhere).
+bool modeFixesFilterOrder(RenderMode mode);
+/// True for the modes without a point path (Splat, Ewa, Swan).
+bool drawsOnlySplats(RenderMode mode);
 
 /// Default bound on the active voxels (tiles counted voxel by voxel) a render accepts: a
 /// few KB of active tiles can hold billions of voxels, hours of work. --max-voxels raises it.
@@ -69,6 +85,8 @@ struct RenderSettings {
     int spp = 16;                           ///< reference: rays per pixel (rounded to a square)
     double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
     FootprintPath footprint = FootprintPath::Auto;
+    /// The reconstruction kernel (--kernel; KernelShape::named): every mode and the reference.
+    std::string kernel = "gaussian";
     FilterOrder filterOrder = FilterOrder::Postfilter;
     int subpixels = kDefaultSubpixels;      ///< Postfilter: sub-pixel grid per axis
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)

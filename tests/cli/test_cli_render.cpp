@@ -43,8 +43,8 @@ namespace fs = std::filesystem;
 using test::slurp;
 using test::spit;
 
-const std::vector<std::string> kAllModes = {"hybrid", "splat", "point", "reference"};
-const std::vector<std::string> kForwardModes = {"hybrid", "splat", "point"};
+const std::vector<std::string> kAllModes = {"hybrid", "splat", "point", "ewa", "swan", "none", "reference"};
+const std::vector<std::string> kForwardModes = {"hybrid", "splat", "point", "ewa", "swan", "none"};
 
 using Result = test::CliResult;
 
@@ -254,6 +254,8 @@ TEST_F(CliRender, HelpDocumentsTablesAndExitsZero) {
     EXPECT_TRUE(r.err.empty()) << r.err;
     EXPECT_NE(r.out.find("usage: vdbsplat render"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("--tables DIR"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("hybrid (default) | splat | point | ewa | swan | none | reference"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--kernel K"), std::string::npos) << r.out;
 }
 
 TEST_F(CliRender, BadVolumeInputs) {
@@ -271,7 +273,8 @@ TEST_F(CliRender, BadVolumeInputs) {
 TEST_F(CliRender, BadFlagValues) {
     const std::string s = vdb("sphere.vdb");
     expectAllFail({
-        {s, {"--mode", "bogus"}, "--mode: unknown mode 'bogus'", {""}},
+        {s, {"--mode", "bogus"}, "--mode: unknown mode 'bogus' (choose hybrid, splat, point, ewa, swan, none, reference)", {""}},
+        {s, {"--kernel", "bspline"}, "--kernel: unknown kernel 'bspline' (choose gaussian, gaussian-sharp)", kAllModes, kParsing},
         {s, {"--tf", "no-such-preset"}, "--tf"},
         {s, {"--size", "4OOx400"}, "--size", kAllModes, kParsing},
         {s, {"--size", "0x0"}, "--size", kAllModes, kParsing},
@@ -449,6 +452,30 @@ TEST_F(CliRender, GoodRenderInEachModeToPngAndExr) {
     }
 }
 
+// The study modes and the kernel are echoed with what they used: ewa and swan low-pass each
+// primitive (prefilter), none nothing (and no level of detail); swan and none draw no points
+// under the threshold... except none, whose minified voxels are nearest-pixel points.
+TEST_F(CliRender, StatsJsonEchoesStudyModesAndKernel) {
+    const fs::path d = runDir("stats-modes");
+    struct Expect { const char* mode; const char* order; double lod; bool points; };
+    for (const Expect e : {Expect{"ewa", "prefilter", 1.25, false}, Expect{"swan", "prefilter", 1.25, false},
+                           Expect{"none", "none", 0.0, true}}) {
+        const fs::path stats = d / "out" / (std::string(e.mode) + ".json");
+        const Result r = runBinary(renderArgs(vdb("sphere.vdb"), (d / "out" / (std::string(e.mode) + ".png")).string(),
+                                              e.mode, {"--size", "32x32", "--kernel", "gaussian-sharp", "--stats", stats.string()}),
+                                   d / "log");
+        ASSERT_EQ(r.rc, 0) << r.err;
+        const nlohmann::json j = nlohmann::json::parse(slurp(stats));
+        EXPECT_EQ(j["mode"], e.mode);
+        EXPECT_EQ(j["kernel"], "gaussian-sharp");
+        EXPECT_EQ(j["filter_order"], e.order) << e.mode;
+        EXPECT_EQ(j["subpixels"], 1) << e.mode;
+        EXPECT_EQ(j["lod"].get<double>(), e.lod) << e.mode;
+        EXPECT_GT(j["splats"].get<double>(), 0.0) << e.mode;
+        EXPECT_EQ(j["points"].get<double>() > 0.0, e.points) << e.mode;
+    }
+}
+
 TEST_F(CliRender, StatsJsonHasCountsTimingsAndSettings) {
     const fs::path d = runDir("stats");
     const fs::path stats = d / "out" / "s.json";
@@ -467,6 +494,7 @@ TEST_F(CliRender, StatsJsonHasCountsTimingsAndSettings) {
     EXPECT_EQ(j["grid"], "density");
     EXPECT_EQ(j["tables"], "");
     EXPECT_EQ(j["footprint"], "auto") << "the default footprint path";
+    EXPECT_EQ(j["kernel"], "gaussian") << "the default kernel";
     EXPECT_GE(j["splats_exact_index"].get<double>(), 0.0);
     EXPECT_LE(j["splats_exact_index"].get<double>(), j["splats"].get<double>());
     EXPECT_GT(j["active_voxels"].get<double>(), 1000.0);

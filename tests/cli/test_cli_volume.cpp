@@ -3,6 +3,8 @@
 // exit, one stderr line "vdbsplat: error: …" naming the file or flag, and no output file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -104,6 +106,16 @@ TEST_F(CliVolume, AnisotropicSpacingConvertsAndRenders) {
         r = run("render " + out + " -o " + path(std::string(mode) + ".png") + " --size 32x32 --spp 1 --mode " + mode);
         EXPECT_EQ(r.rc, 0) << r.err;
         EXPECT_TRUE(fs::exists(path(std::string(mode) + ".png")));
+    }
+    // The affine EWA and Swan footprints and the second kernel are defined for spheres: refused
+    // with one line naming the flag and the file, nothing written.
+    for (const char* flags : {"--mode ewa", "--mode swan", "--kernel gaussian-sharp"}) {
+        r = run("render " + out + " -o " + path("x.png") + " --size 32x32 " + flags);
+        EXPECT_EQ(r.rc, 1) << flags;
+        EXPECT_NE(r.err.find(std::string(flags).substr(0, std::string(flags).find(' '))), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("non-cubic or sheared voxels"), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_FALSE(fs::exists(path("x.png")));
     }
 }
 

@@ -195,7 +195,8 @@ double maxDifference(const Image& a, const Image& b) {
 
 TEST(TileCompositor, MatchesTheSlowPerPixelCompositor) {
     const Camera camera = testCamera(72);  // 72 = 4.5 tiles: partial tiles at the edges
-    for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Point, RenderMode::Splat}) {
+    for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Point, RenderMode::Splat, RenderMode::Ewa,
+                                  RenderMode::Swan, RenderMode::None}) {
         const auto windows = randomWindows(camera, mode);
         int points = 0, splats = 0;
         for (const auto& w : windows)

@@ -44,7 +44,7 @@ glm::dvec3 ray(const PixelCoord& p) { return {(p.x - kPrincipal.x) / kF, -(p.y -
 TEST(Ellipsoid, ConicMatchesBruteForceRays) {
     int tested = 0, inside = 0;
     for (const glm::dmat3& m : shapes()) {
-        const KernelShape shape = KernelShape::of(m);
+        const VoxelShape shape = VoxelShape::of(m);
         EXPECT_FALSE(shape.sphere);
         for (const ViewPoint& c : centres()) {
             const EllipsoidProjection e = projectEllipsoid(shape, c, kF, kPrincipal);
@@ -75,7 +75,7 @@ TEST(Ellipsoid, ConicMatchesBruteForceRays) {
 // The ray–centre distance in index space against the line transformed explicitly.
 TEST(Ellipsoid, IndexSpaceDistanceIsTheDistanceOfTheTransformedLine) {
     for (const glm::dmat3& m : shapes()) {
-        const KernelShape shape = KernelShape::of(m);
+        const VoxelShape shape = VoxelShape::of(m);
         for (const ViewPoint& c : centres())
             for (const glm::dvec3 v : {glm::dvec3(0.1, -0.05, 1.0), glm::dvec3(c / c.z) + glm::dvec3(0.01, 0.02, 0.0)}) {
                 const glm::dvec3 o = shape.N * (-c), d = glm::normalize(shape.N * v);
@@ -89,7 +89,7 @@ TEST(Ellipsoid, IndexSpaceDistanceIsTheDistanceOfTheTransformedLine) {
 // M = h·(rotation): the ellipse of DESIGN §2 (projectSphere), whatever the rotation.
 TEST(Ellipsoid, SphereShapeGivesDesignEllipse) {
     for (double h : {1.0, 0.37}) {
-        const KernelShape shape = KernelShape::of(h * rotation(0.9, {1, 1, 1}));
+        const VoxelShape shape = VoxelShape::of(h * rotation(0.9, {1, 1, 1}));
         EXPECT_TRUE(shape.sphere);
         EXPECT_NEAR(shape.h, h, 1e-12);
         for (const ViewPoint& c : centres()) {
@@ -114,7 +114,7 @@ TEST(Ellipsoid, SphereShapeGivesDesignEllipse) {
 // the pullback is the identity), in float.
 TEST(Ellipsoid, IndexMapMatchesTheExactDistance) {
     for (const glm::dmat3& m : shapes()) {
-        const KernelShape shape = KernelShape::of(m);
+        const VoxelShape shape = VoxelShape::of(m);
         for (const ViewPoint& c : centres()) {
             const EllipsoidProjection e = projectEllipsoid(shape, c, kF, kPrincipal);
             const ScreenKernel k = makeScreenKernel(e.ellipse, 0.0);
@@ -134,7 +134,7 @@ TEST(Ellipsoid, IndexMapMatchesTheExactDistance) {
 // times the world length per index length along the ray, over h.
 TEST(Ellipsoid, HalfRayDepositInFrontIsTheFullChord) {
     for (const glm::dmat3& m : shapes()) {
-        const KernelShape shape = KernelShape::of(m);
+        const VoxelShape shape = VoxelShape::of(m);
         for (const ViewPoint& c : centres()) {
             const glm::dvec3 v = c / c.z + glm::dvec3(0.003, -0.002, 0.0);
             const double d2 = ellipsoidRayDistance2(shape, c, v);
@@ -149,7 +149,7 @@ TEST(Ellipsoid, HalfRayDepositInFrontIsTheFullChord) {
 }
 
 TEST(Ellipsoid, ClassesAtTheEye) {
-    const KernelShape shape = KernelShape::of(shapes()[1]);
+    const VoxelShape shape = VoxelShape::of(shapes()[1]);
     EXPECT_EQ(projectEllipsoid(shape, {0.0, 0.0, -20.0}, kF, kPrincipal).kind, SphereClass::Behind);
     EXPECT_EQ(projectEllipsoid(shape, {0.1, 0.0, 0.2}, kF, kPrincipal).kind, SphereClass::EyeInside);
     const EllipsoidProjection s = projectEllipsoid(shape, {8.0, 0.0, 1.0}, kF, kPrincipal);
@@ -163,7 +163,7 @@ TEST(Ellipsoid, SingularValuesOfStretchedAndRotatedMaps) {
     EXPECT_NEAR(s.x, 2.5, 1e-12);
     EXPECT_NEAR(s.y, 1.0, 1e-12);
     EXPECT_NEAR(s.z, 0.5, 1e-12);
-    const KernelShape k = KernelShape::of(glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 2.5)));
+    const VoxelShape k = VoxelShape::of(glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 2.5)));
     EXPECT_NEAR(k.volume, 2.5, 1e-12);
     EXPECT_NEAR(k.h, std::cbrt(2.5), 1e-12);
     EXPECT_NEAR(k.lengthAlong({0, 0, 1}), 2.5, 1e-12);
