@@ -18,6 +18,14 @@ std::string fmt(double v, const char* format) {
     return buf;
 }
 
+/// A CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break (a grid name can).
+std::string csvField(const std::string& text) {
+    if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+    std::string q = "\"";
+    for (const char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
+}
+
 std::string psnrText(double psnr) { return std::isfinite(psnr) ? fmt(psnr, "%.2f") : "inf"; }
 
 double splatFraction(const ModeResult& m) {
@@ -74,7 +82,7 @@ std::string csvHeader() {
 std::string metricsCsv(const StudyResult& study) {
     std::string out = csvHeader() + "\n";
     forEachRow(study, [&](const VolumeResult& vol, const KernelResult& k, const ViewResult& v, const ModeResult& m) {
-        out += vol.id + "," + vol.grid + "," + k.kernel + "," + v.view.id + "," + fmt(v.view.distance, "%.9g") + "," +
+        out += vol.id + "," + csvField(vol.grid) + "," + k.kernel + "," + v.view.id + "," + fmt(v.view.distance, "%.9g") + "," +
                fmt(v.view.zoom(), "%.9g") + "," + m.mode + "," + psnrText(m.metrics.psnr) + "," +
                fmt(m.metrics.ssim, "%.6f") + "," + fmt(m.metrics.rmse, "%.6g") + "," +
                fmt(m.metrics.maxAbsError, "%.6g") + "," + fmt(m.seconds, "%.6f") + "," +

@@ -152,6 +152,9 @@ TEST(StudyReport, CsvAndJson) {
     EXPECT_EQ(csv.substr(0, csv.find('\n')), csvHeader());
     EXPECT_NE(csv.find(",hybrid,inf,"), std::string::npos);
     EXPECT_NE(csv.find(",point,38.00,"), std::string::npos);
+    StudyResult odd = s;
+    odd.volumes[0].grid = "a,\"b\"";
+    EXPECT_NE(metricsCsv(odd).find("\nsphere,\"a,\"\"b\"\"\",gaussian,"), std::string::npos) << metricsCsv(odd);
     const auto j = metricsJson(s);
     ASSERT_EQ(j["rows"].size(), 6u);
     EXPECT_TRUE(j["rows"][0]["psnr_db"].is_null());
