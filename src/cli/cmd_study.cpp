@@ -14,6 +14,7 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -226,6 +227,8 @@ std::vector<View> viewsFrom(const Args& args) {
             views.push_back(study::viewAt(d));
         }
     views = study::withoutRepeats(views);
+    // Far to close: the report, the CSV and the plots read in zoom order.
+    std::stable_sort(views.begin(), views.end(), [](const View& a, const View& b) { return a.distance > b.distance; });
     if (views.size() > study::kMaxViews)
         throw Error("--views: at most " + std::to_string(study::kMaxViews) + " views in one study");
     return views;
@@ -425,7 +428,26 @@ std::vector<LoadedVolume> loadVolumes(const Options& o) {
 
 struct Counters {
     size_t total = 0, done = 0, rendered = 0, kept = 0;
+    bool warmedUp = false;
 };
+
+/// One small untimed render per mode before the first timed one: the first render of a process
+/// pays for starting the worker threads and first-touching memory, which would otherwise land on
+/// whichever cell comes first (measured: 0.71 s against 0.32 s for the same splat render).
+void warmUp(const Options& o, const LoadedVolume& lv, const TransferFunction& tf, const KernelPlan& k,
+            const View& view, const RenderControl& control) {
+    std::vector<RenderMode> modes = o.modes;
+    modes.push_back(RenderMode::Reference);
+    for (RenderMode m : modes) {
+        RenderSettings s = k.settings;
+        s.mode = m;
+        s.spp = 1;
+        s.camera.distance = view.distance;
+        s.camera.width = s.camera.height = 32;
+        RenderStats st;
+        (void)render(lv.volume, tf, s, st, control);
+    }
+}
 
 std::string relativeTo(const fs::path& p, const fs::path& dir) { return fs::relative(p, dir).generic_string(); }
 
@@ -446,6 +468,10 @@ study::ViewResult runView(const Options& o, const LoadedVolume& lv, const Transf
         const std::string hash = study::fnv1a(identity.dump());
         const fs::path stem = folder / name;
         std::optional<Rendered> r = o.resume ? keptRender(stem, hash, s) : std::nullopt;
+        if (!r && !n.warmedUp) {
+            warmUp(o, lv, tf, k, view, control);
+            n.warmedUp = true;
+        }
         if (!r) r = makeRender(stem, hash, identity, lv.volume, tf, s, camera, control);
         ++(r->kept ? n.kept : n.rendered);
         ++n.done;

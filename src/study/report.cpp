@@ -159,7 +159,7 @@ std::string plotSvg(const Plot& plot) {
         if (ymax - ymin < 0.5) ymax = ymin + 0.5;
     } else {
         const double span = std::max(ymax - ymin, 1e-6), pad = 0.08 * span;
-        ymin -= pad, ymax += pad;
+        ymin -= pad, ymax = std::min(ymax + pad, std::max(plot.yCap, ymax));
     }
     const double xpad = 0.06 * (xmax - xmin);
     xmin -= xpad, xmax += xpad;
@@ -182,19 +182,26 @@ std::string plotSvg(const Plot& plot) {
         if (yticks.size() < 2)
             for (double e = std::ceil(ymin * 2) / 2; e <= ymax + 1e-9; e += 0.5) yticks.push_back(std::pow(10.0, e));
     } else {
-        for (int k = 0; k <= 4; ++k) yticks.push_back(ymin + (ymax - ymin) * k / 4.0);
+        // Round steps (1, 2 or 5 times a power of ten), about four of them.
+        const double raw = (ymax - ymin) / 4.0, mag = std::pow(10.0, std::floor(std::log10(raw)));
+        const double step = raw / mag < 1.5 ? mag : raw / mag < 3.5 ? 2 * mag : raw / mag < 7.5 ? 5 * mag : 10 * mag;
+        for (double t = std::ceil(ymin / step) * step; t <= ymax + 1e-12; t += step) yticks.push_back(std::abs(t) < 1e-12 ? 0.0 : t);
     }
     for (const double t : yticks) {
         const double y = Y(t);
         s << "<line x1=\"" << left << "\" y1=\"" << fmt(y, "%.2f") << "\" x2=\"" << left + pw << "\" y2=\""
           << fmt(y, "%.2f") << "\" stroke=\"#eee\"/>\n";
         s << "<text x=\"" << left - 5 << "\" y=\"" << fmt(y + 4, "%.2f") << "\" text-anchor=\"end\">"
-          << (plot.logY ? fmt(t, "%.3g") : fmt(t, std::abs(ymax - ymin) < 0.05 ? "%.4f" : "%.3g")) << "</text>\n";
+          << fmt(t, plot.logY ? "%.3g" : "%.6g") << "</text>\n";
     }
     std::sort(xs.begin(), xs.end());
+    double lastLabel = -1e9;
     for (const double x : xs) {
+        const bool label = X(x) - lastLabel >= 34;  // crowded ticks (2× beside 2.86×) keep only their line
+        if (label) lastLabel = X(x);
         s << "<line x1=\"" << fmt(X(x), "%.2f") << "\" y1=\"" << top << "\" x2=\"" << fmt(X(x), "%.2f") << "\" y2=\""
           << top + ph << "\" stroke=\"#eee\"/>\n";
+        if (!label) continue;
         s << "<text x=\"" << fmt(X(x), "%.2f") << "\" y=\"" << top + ph + 14 << "\" text-anchor=\"middle\">"
           << htmlEscape(zoomText(x)) << "</text>\n";
     }
@@ -230,7 +237,7 @@ std::string plotSvg(const Plot& plot) {
 }
 
 std::string colourBarSvg() {
-    const double W = 220, H = 44, left = 10, barW = 200, barH = 14;
+    const double W = 236, H = 44, left = 16, barW = 200, barH = 14;
     std::ostringstream s;
     s << "<svg class=\"colourbar\" xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
       << "\" viewBox=\"0 0 " << W << " " << H << "\" font-family=\"sans-serif\" font-size=\"10\" role=\"img\">\n";
@@ -324,7 +331,7 @@ std::string viewHtml(const StudyResult& study, const ViewResult& v) {
 
 std::string plotsHtml(const StudyResult& study, const VolumeResult& vol, const KernelResult& k) {
     Plot psnr{vol.id + " — PSNR against the reference", "zoom (1 = framed)", "PSNR (dB)", false, {}};
-    Plot ssim{vol.id + " — SSIM against the reference", "zoom (1 = framed)", "SSIM", false, {}};
+    Plot ssim{vol.id + " — SSIM against the reference", "zoom (1 = framed)", "SSIM", false, {}, 1.0};
     Plot time{vol.id + " — render time", "zoom (1 = framed)", "seconds (log)", true, {}};
     for (size_t mi = 0; mi < study.modes.size(); ++mi) {
         Series p{study.modes[mi], modeColour(mi), false, {}, {}}, q = p, t = p;

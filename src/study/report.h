@@ -9,6 +9,7 @@
 // images that loaded into #selfcheck (what the end-to-end test reads back).
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -79,6 +80,7 @@ struct Plot {
     std::string title, xLabel, yLabel;
     bool logY = false;
     std::vector<Series> series;
+    double yCap = std::numeric_limits<double>::infinity();  ///< linear axis: never above (SSIM: 1)
 };
 
 /// @brief The chart as an inline <svg class="plot"> element (axes, ticks, lines, legend).

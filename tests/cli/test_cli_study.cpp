@@ -130,6 +130,7 @@ TEST_F(StudyCli, TinyStudyWritesEveryFile) {
         seen.insert(f[col["view"]] + "/" + f[col["mode"]]);
     }
     EXPECT_EQ(seen, (std::set<std::string>{"d2/hybrid", "d2/point", "d0_5/hybrid", "d0_5/point"}));
+    EXPECT_EQ(fields(csv[1])[col["view"]], "d2");  // far to close
 
     // metrics.json holds the same rows.
     const auto j = nlohmann::json::parse(slurp(dir + "/metrics.json"));
@@ -222,8 +223,8 @@ TEST_F(StudyCli, ZoomLadderAndStandardViews) {
     auto col = columns(csv[0]);
     std::vector<double> zooms;
     for (size_t i = 1; i < csv.size(); ++i) zooms.push_back(std::stod(fields(csv[i])[col["zoom"]]));
-    // 1/8 … 8 (distance 8 and 1 shared with the standard views), then close (0.35).
-    const std::vector<double> expected{0.125, 0.25, 0.5, 1, 2, 4, 8, 1 / 0.35};
+    // 1/8 … 8 with close (distance 0.35) between 2× and 4×: far to close, distances 8 and 1 once.
+    const std::vector<double> expected{0.125, 0.25, 0.5, 1, 2, 1 / 0.35, 4, 8};
     ASSERT_EQ(zooms.size(), expected.size()) << slurp(dir + "/metrics.csv");
     for (size_t i = 0; i < zooms.size(); ++i) EXPECT_NEAR(zooms[i], expected[i], 1e-6);
 }
@@ -276,19 +277,19 @@ TEST_F(StudyCli, BadInputOneLineNothingWritten) {
     EXPECT_FALSE(fs::exists(dir));
 }
 
-/// Starts a long study (no shell: the signals at their default, as in a terminal), waits until
-/// its first view is finished, sends @p sig, and checks the interruption contract; then
+/// Starts a long study (no shell: the signals at their default, as in a terminal; views are
+/// rendered far to close), waits until its first view is finished, sends @p sig, and checks the interruption contract; then
 /// --resume keeps every finished render.
 void interruptAndCheck(const std::string& vdbPath, const test::ScratchDir& scratch, int sig) {
     const std::string tag = std::to_string(sig);
     const std::string dir = scratch.path("int" + tag), outPath = scratch.path("o" + tag), errPath = scratch.path("e" + tag);
     std::string distances;
-    for (int i = 0; i < 60; ++i) distances += (i ? "," : "") + std::to_string(2.0 + 0.05 * i);
+    for (int i = 0; i < 60; ++i) distances += (i ? "," : "") + std::to_string(5.0 - 0.05 * i);  // far to close
     const std::vector<std::string> args{"study", vdbPath, "-o", dir, "--distances", distances, "--modes", "hybrid,splat",
                                         "--size", "24x24", "--spp", "4", "--threads", "1"};
     const pid_t pid = test::spawnVdbsplat(args, outPath, errPath);
     ASSERT_GT(pid, 0);
-    const std::string first = dir + "/images/sphere/gaussian/d2/splat.json";
+    const std::string first = dir + "/images/sphere/gaussian/d5/splat.json";  // the first view's last render
     for (int i = 0; i < 2400 && !fs::exists(first); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
     ASSERT_TRUE(fs::exists(first));
     ::kill(pid, sig);
@@ -314,7 +315,7 @@ void interruptAndCheck(const std::string& vdbPath, const test::ScratchDir& scrat
     }
     EXPECT_GE(finished, 3u);
     const CliResult resumed = test::runVdbsplat(
-        "study '" + vdbPath + "' -o '" + dir + "' --distances 2 --modes hybrid,splat --size 24x24 --spp 4 --resume",
+        "study '" + vdbPath + "' -o '" + dir + "' --distances 5 --modes hybrid,splat --size 24x24 --spp 4 --resume",
         scratch.dir());
     ASSERT_EQ(resumed.rc, 0) << resumed.err;
     EXPECT_NE(resumed.out.find("(0 rendered, 3 kept)"), std::string::npos) << resumed.out;
