@@ -310,7 +310,9 @@ std::string img(const std::string& cls, const std::string& src, const std::strin
 
 std::string viewHtml(const StudyResult& study, const ViewResult& v) {
     std::ostringstream s;
-    s << "<h4>" << htmlEscape(v.view.label) << " — zoom " << htmlEscape(zoomText(v.view.zoom())) << "</h4>\n";
+    s << "<h4>" << htmlEscape(v.view.label);
+    if (v.view.label.rfind("zoom ", 0) != 0) s << " — zoom " << htmlEscape(zoomText(v.view.zoom()));  // the ladder's say it
+    s << "</h4>\n";
     s << "<div class=\"methods\">\n<figure>" << img("render", v.referenceImage, "reference") << "<figcaption><b>reference</b>, "
       << study.spp << " rays/pixel, " << fmt(v.referenceSeconds, "%.3g") << " s</figcaption>" << colourBarSvg()
       << "<figcaption>error scale of the maps below each mode</figcaption>"
