@@ -324,6 +324,45 @@ void interruptAndCheck(const std::string& vdbPath, const test::ScratchDir& scrat
 TEST_F(StudyCli, InterruptedByCtrlC) { interruptAndCheck(vdb(), local_, SIGINT); }
 TEST_F(StudyCli, InterruptedBySigterm) { interruptAndCheck(vdb(), local_, SIGTERM); }
 
+TEST_F(StudyCli, KilledHardKeepsFinishedRendersAndResumeCleansUp) {
+    // SIGKILL cannot be caught: whatever was being written is left as a temporary at most, never
+    // as a half-written file under its own name; --resume removes the temporaries and keeps
+    // every render whose record (.json, written last) is there.
+    const std::string dir = out("killed"), outPath = out("o9"), errPath = out("e9");
+    std::string distances;
+    for (int i = 0; i < 60; ++i) distances += (i ? "," : "") + std::to_string(5.0 - 0.05 * i);
+    const pid_t pid = test::spawnVdbsplat({"study", vdb(), "-o", dir, "--distances", distances, "--modes", "hybrid,splat",
+                                           "--size", "24x24", "--spp", "4", "--threads", "1"},
+                                          outPath, errPath);
+    ASSERT_GT(pid, 0);
+    const std::string first = dir + "/images/sphere/gaussian/d5/splat.json";
+    for (int i = 0; i < 2400 && !fs::exists(first); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    ASSERT_TRUE(fs::exists(first));
+    ::kill(pid, SIGKILL);
+    const int status = test::waitBounded(pid, 60);
+    ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+    EXPECT_FALSE(fs::exists(dir + "/index.html"));
+    size_t finished = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        const std::string p = e.path().string();
+        if (!p.ends_with(".json") || p.find(".tmp") != std::string::npos) continue;
+        ++finished;
+        const std::string stem = p.substr(0, p.size() - 5);
+        EXPECT_EQ(readImage(stem + ".exr").width, 24) << stem;
+        EXPECT_EQ(readImage(stem + ".png").width, 24) << stem;
+        EXPECT_NO_THROW((void)nlohmann::json::parse(slurp(p))) << p;
+    }
+    EXPECT_GE(finished, 3u);
+    const CliResult resumed = test::runVdbsplat(
+        "study '" + vdb() + "' -o '" + dir + "' --distances 5,4.95 --modes hybrid,splat --size 24x24 --spp 4 --resume",
+        local_.dir());
+    ASSERT_EQ(resumed.rc, 0) << resumed.err;
+    EXPECT_NE(resumed.out.find(" kept)"), std::string::npos) << resumed.out;
+    EXPECT_EQ(resumed.out.find("(6 rendered"), std::string::npos) << resumed.out;  // the first view was kept
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
 /// The value of attribute @p name of the element with id="selfcheck" in a DOM dump ("" if absent).
 std::string selfcheck(const std::string& dom, const std::string& name) {
     const size_t p = dom.find("id=\"selfcheck\"");
