@@ -222,8 +222,8 @@ std::vector<View> viewsFrom(const Args& args) {
     if (auto v = args.get("--distances"))
         for (const std::string& item : study::splitList(*v, "--distances")) {
             const double d = parseDouble(item, "--distances");
-            if (!(d > 0.0 && d < 1e6))
-                throw Error("--distances: each must be a positive number below 1e6, got '" + printable(item) + "'");
+            if (!(d >= study::kMinDistance && d < 1e6))
+                throw Error("--distances: each must be a number in [0.0001, 1e6), got '" + printable(item) + "'");
             views.push_back(study::viewAt(d));
         }
     views = study::withoutRepeats(views);

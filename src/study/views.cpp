@@ -24,7 +24,7 @@ std::vector<View> standardViews() {
 }
 
 std::vector<View> zoomLadder(double base) {
-    if (!(base > 0.0 && base < 1e5)) throw Error("--base: must be a positive number below 1e5, got " + number(base));
+    if (!(base >= 1e-3 && base < 1e5)) throw Error("--base: must be a number in [0.001, 1e5), got " + number(base));
     const struct {
         double zoom;
         const char* text;

@@ -20,6 +20,10 @@ struct View {
     double zoom() const { return 1.0 / distance; }
 };
 
+/// The nearest framing distance a study takes: far inside any grid's bounds (1e-4 of the framing
+/// distance), well before the eye and the look-at point coincide in double precision.
+inline constexpr double kMinDistance = 1e-4;
+
 /// Most views one study accepts (each is rendered in every mode, kernel and volume).
 inline constexpr size_t kMaxViews = 64;
 
@@ -27,7 +31,7 @@ inline constexpr size_t kMaxViews = 64;
 std::vector<View> standardViews();
 
 /// @brief Zoom 1/8× … 8× in factors of two around framing distance @p base (distance base/s).
-/// @throw Error "--base: …" unless 0 < base < 1e5.
+/// @throw Error "--base: …" unless 0.001 <= base < 1e5 (so every distance is at least kMinDistance).
 std::vector<View> zoomLadder(double base);
 
 /// @brief A view at framing distance @p distance, labelled with it ("distance 2.5").
