@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -39,6 +40,7 @@
 #include "render/render.h"
 #include "study/error_map.h"
 #include "study/report.h"
+#include "study/spec.h"
 #include "study/views.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -78,6 +80,9 @@ const char* kHelp =
     "                     check out, render the rest (changed settings: only what they change)\n"
     "  --force            start afresh in a non-empty DIR (removes images/, index.html, metrics.*,\n"
     "                     command.txt)\n"
+    "  --spec FILE.json   the study's volumes and settings from a file (docs/usage.md, \"study\"):\n"
+    "                     {\"volumes\": [...], \"modes\": [...], \"views\": [...], \"size\": [W, H], ...};\n"
+    "                     flags on the command line add to it (not the same setting twice)\n"
     "\n"
     "render flags (as vdbsplat render; the same for every mode and view):\n"
     "  --grid NAME, --tf PRESET|FILE, --fov DEG, --up X,Y,Z, --view-dir X,Y,Z, --threshold PX,\n"
@@ -117,7 +122,7 @@ std::set<std::string> studyValueFlags() {
     std::set<std::string> flags;
     for (const std::string& f : renderValueFlags())
         if (!kStudyOwned.count(f)) flags.insert(f);
-    flags.insert({"-o", "--modes", "--kernels", "--views", "--base", "--distances"});
+    flags.insert({"-o", "--modes", "--kernels", "--views", "--base", "--distances", "--spec"});
     return flags;
 }
 
@@ -524,15 +529,62 @@ void appendCommand(const fs::path& dir, const std::string& command) {
     writeTextFileAtomic((dir / "command.txt").string(), previous + command + "\n");
 }
 
+const std::set<std::string> kSwitches{"--show-primitives", "--resume", "--force"};
+
+/// The command line with --spec FILE replaced by the arguments the file stands for (its volumes
+/// first). @p fromSpec receives flag → key for the flags the file gave.
+/// @throw Error naming the file for a bad file, or a setting given both there and as a flag.
+Argv withSpec(const Argv& argv, const Args& args, std::map<std::string, std::string>& fromSpec) {
+    const auto spec = args.get("--spec");
+    if (!spec) return argv;
+    if (spec->empty()) throw Error("--spec: expected a file name, got ''");
+    Argv volumes, flags;
+    for (const study::SpecArgument& a : study::loadSpec(*spec)) {
+        if (a.key == "volumes") {
+            if (!args.positionals().empty())
+                throw Error(*spec + ": volumes: also given on the command line (give them in one place)");
+            volumes = a.args;
+            continue;
+        }
+        if (args.has(a.args.front()))
+            throw Error(*spec + ": " + a.key + ": also given as " + a.args.front() + " on the command line");
+        fromSpec[a.args.front()] = a.key;
+        flags.insert(flags.end(), a.args.begin(), a.args.end());
+    }
+    Argv out = volumes;
+    out.insert(out.end(), flags.begin(), flags.end());
+    for (size_t i = 0; i < argv.size(); ++i) {
+        if (argv[i] == "--spec") { ++i; continue; }
+        if (argv[i].rfind("--spec=", 0) == 0) continue;
+        out.push_back(argv[i]);
+    }
+    return out;
+}
+
+/// optionsFrom, with a bad value that came from the study file named by the file and its key.
+Options optionsWithSpec(const Args& args, const std::map<std::string, std::string>& fromSpec, const std::string& spec) {
+    try {
+        return optionsFrom(args);
+    } catch (const Error& e) {
+        const std::string m = e.what();  // "--flag: …" or "--flag width: …"
+        const std::string flag = m.substr(0, m.find_first_of(": "));
+        if (const auto it = fromSpec.find(flag); it != fromSpec.end())
+            throw Error(spec + ": " + it->second + m.substr(flag.size()));
+        throw;
+    }
+}
+
 }  // namespace
 
 int runStudy(const Argv& argv) {
-    const Args args(argv, studyValueFlags(), {"--show-primitives", "--resume", "--force"});
-    if (args.wantsHelp()) {
+    const Args given(argv, studyValueFlags(), kSwitches);
+    if (given.wantsHelp()) {
         std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp;
         return 0;
     }
-    const Options o = optionsFrom(args);
+    std::map<std::string, std::string> fromSpec;
+    const Args args(withSpec(argv, given, fromSpec), studyValueFlags(), kSwitches);
+    const Options o = optionsWithSpec(args, fromSpec, given.getOr("--spec", ""));
     checkFolder(o);
     const RenderSettings& base = o.kernels.front().settings;
     std::unique_ptr<tbb::global_control> threads;

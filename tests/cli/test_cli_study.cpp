@@ -366,6 +366,56 @@ TEST_F(StudyCli, KilledHardKeepsFinishedRendersAndResumeCleansUp) {
         EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
 
+TEST_F(StudyCli, StudyFileRunsAndIsValidatedLikeFlags) {
+    const std::string spec = out("study.json"), dir = out("spec");
+    spit(spec, "{\"volumes\": [\"" + vdb() + "\"], \"modes\": [\"hybrid\", \"point\"], \"distances\": [2, 0.5],\n"
+               " \"size\": [40, 32], \"spp\": 2, \"tf\": \"grey\", \"threshold\": 1}");
+    const CliResult r = test::runVdbsplat("study --spec '" + spec + "' -o '" + dir + "' --threads 1", local_.dir());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.out.find("6 renders (6 rendered, 0 kept)"), std::string::npos) << r.out;
+    EXPECT_EQ(lines(slurp(dir + "/metrics.csv")).size(), 5u);
+    EXPECT_EQ(readImage(dir + "/images/sphere/gaussian/d2/hybrid.png").width, 40);
+    EXPECT_NE(slurp(dir + "/command.txt").find("--spec"), std::string::npos);
+
+    const std::string never = out("never-spec");
+    struct Case {
+        std::string content, needle, extra;
+    };
+    const std::string v = "\"volumes\": [\"" + vdb() + "\"]";
+    const std::vector<Case> cases{
+        {"not json", "not valid JSON", ""},
+        {"[1, 2]", "expected a JSON object, got array", ""},
+        {"{\"modes\": [\"hybrid\"]}", "volumes: missing", ""},
+        {"{\"volumes\": []}", "volumes: empty list", ""},
+        {"{\"volumes\": \"a.vdb\"}", "volumes: expected an array", ""},
+        {"{" + v + ", \"nosuch\": 1}", "unknown key 'nosuch'", ""},
+        {"{" + v + ", \"modes\": [\"hybrid,point\"]}", "modes[0]: 'hybrid,point' holds a comma", ""},
+        {"{" + v + ", \"modes\": [\"nosuch\"]}", "modes: unknown mode 'nosuch'", ""},
+        {"{" + v + ", \"modes\": []}", "modes: empty list", ""},
+        {"{" + v + ", \"distances\": [1, \"a\"]}", "distances[1]: expected a number, got string", ""},
+        {"{" + v + ", \"distances\": [-1]}", "distances: each must be a number in", ""},
+        {"{" + v + ", \"size\": [40]}", "size: expected [width, height]", ""},
+        {"{" + v + ", \"size\": [0, 40]}", "size width: expected an integer in [1, 16384]", ""},
+        {"{" + v + ", \"spp\": 1.5}", "spp: expected an integer", ""},
+        {"{" + v + ", \"base\": 2}", "base: needs --views ladder", ""},
+        {"{" + v + ", \"tf\": \"\"}", "tf: empty string", ""},
+        {"{" + v + ", \"views\": [[\"standard\"]]}", "nested deeper than 2", ""},
+        {"{" + v + ", \"spp\": 1e999}", "not valid JSON", ""},
+        {"{" + v + ", \"modes\": [\"hybrid\"]}", "modes: also given as --modes", " --modes point"},
+        {"{" + v + "}", "volumes: also given on the command line", " '" + vdb() + "'"},
+    };
+    for (const Case& c : cases) {
+        spit(spec, c.content);
+        const CliResult bad =
+            test::runVdbsplat("study --spec '" + spec + "' -o '" + never + "'" + c.extra, local_.dir());
+        test::expectOneLineError(bad, c.needle, c.content);
+        EXPECT_NE(bad.err.find(spec), std::string::npos) << bad.err;  // names the file
+    }
+    test::expectOneLineError(test::runVdbsplat("study --spec '" + out("none.json") + "' -o '" + never + "'", local_.dir()),
+                             "no such study file");
+    EXPECT_FALSE(fs::exists(never));
+}
+
 /// The value of attribute @p name of the element with id="selfcheck" in a DOM dump ("" if absent).
 std::string selfcheck(const std::string& dom, const std::string& name) {
     const size_t p = dom.find("id=\"selfcheck\"");

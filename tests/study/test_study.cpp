@@ -3,12 +3,14 @@
 // plots and the report's HTML (escaping, one <img> per picture, the self-check element).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
 #include "study/error_map.h"
 #include "study/report.h"
+#include "study/spec.h"
 #include "study/views.h"
 #include "support/error_of.h"
 #include "util/error.h"
@@ -194,6 +196,29 @@ TEST(StudyReport, HtmlNamesEveryPictureAndEscapes) {
     EXPECT_EQ(html.find("a<b>"), std::string::npos);
     EXPECT_EQ(html.find("https://"), std::string::npos);
     EXPECT_EQ(htmlEscape("\"'&"), "&quot;&#39;&amp;");
+}
+
+TEST(StudySpec, FileToArguments) {
+    const auto a = parseSpec(R"({"volumes": ["a.vdb", "b c.vdb"], "modes": ["hybrid", "splat"], "distances": [2, 0.5],
+                                 "size": [160, 120], "spp": 16, "tf": "ct-bone", "threshold": 1.5})",
+                             "s.json");
+    ASSERT_EQ(a.size(), 7u);
+    std::vector<std::string> flat;
+    for (const auto& x : a) flat.insert(flat.end(), x.args.begin(), x.args.end());
+    const std::vector<std::string> expected{"--distances", "2,0.5", "--modes", "hybrid,splat", "--size", "160x120",
+                                            "--spp", "16", "--tf", "ct-bone", "--threshold", "1.5", "a.vdb", "b c.vdb"};
+    std::vector<std::string> sortedFlat = flat, sortedExpected = expected;
+    std::sort(sortedFlat.begin(), sortedFlat.end());
+    std::sort(sortedExpected.begin(), sortedExpected.end());
+    EXPECT_EQ(sortedFlat, sortedExpected);
+    auto err = [](const std::string& text) { return test::errorOf([&] { parseSpec(text, "s.json"); }); };
+    EXPECT_EQ(err("{}").rfind("s.json: volumes: missing", 0), 0u);
+    EXPECT_NE(err(R"({"volumes": ["a"], "size": [1.5, 2]})").find("size[0]: expected an integer"), std::string::npos);
+    EXPECT_NE(err(R"({"volumes": ["a"], "lod": null})").find("lod: expected a number, got null"), std::string::npos);
+    EXPECT_NE(err(R"({"volumes": [""]})").find("volumes[0]: empty string"), std::string::npos);
+    EXPECT_NE(err(std::string(kMaxSpecBytes + 1, ' ')).find("larger than 1 MB"), std::string::npos);
+    EXPECT_NE(err(std::string(100000, '[')).find("nested deeper"), std::string::npos);
+    EXPECT_NE(err("{\"volumes\": [\"a\"], \"tf\": \"x\\u0000y\"}").find("NUL"), std::string::npos);
 }
 
 }  // namespace
