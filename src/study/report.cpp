@@ -212,7 +212,10 @@ std::string plotSvg(const Plot& plot) {
     // Lines, markers, legend.
     double lx = left;
     const double ly = H - 12;
-    for (const Series& ser : plot.series) {
+    for (size_t si = 0; si < plot.series.size(); ++si) {
+        const Series& ser = plot.series[si];
+        // Earlier series wider, so a line lying on another (hybrid on point or splat) still shows.
+        const double width = 1.5 + 1.5 * double(plot.series.size() - 1 - si);
         std::string pts;
         std::vector<std::pair<double, double>> sorted;
         for (size_t i = 0; i < ser.x.size() && i < ser.y.size(); ++i)
@@ -222,9 +225,11 @@ std::string plotSvg(const Plot& plot) {
         const std::string dash = ser.dashed ? " stroke-dasharray=\"5 3\"" : "";
         if (!pts.empty())
             s << "<polyline class=\"series\" data-name=\"" << htmlEscape(ser.name) << "\" fill=\"none\" stroke=\""
-              << ser.colour << "\" stroke-width=\"2\"" << dash << " points=\"" << pts << "\"/>\n";
+              << ser.colour << "\" stroke-width=\"" << width << "\" stroke-opacity=\"0.85\"" << dash << " points=\"" << pts
+              << "\"/>\n";
         for (const auto& [x, y] : sorted)
-            s << "<circle cx=\"" << fmt(X(x), "%.2f") << "\" cy=\"" << fmt(Y(y), "%.2f") << "\" r=\"3\" fill=\""
+            s << "<circle cx=\"" << fmt(X(x), "%.2f") << "\" cy=\"" << fmt(Y(y), "%.2f") << "\" r=\"" << 1.5 + width / 2
+              << "\" fill=\""
               << ser.colour << "\"><title>" << htmlEscape(ser.name) << " at zoom " << htmlEscape(zoomText(x)) << ": "
               << fmt(y, "%.4g") << "</title></circle>\n";
         s << "<line x1=\"" << lx << "\" y1=\"" << ly - 4 << "\" x2=\"" << lx + 16 << "\" y2=\"" << ly - 4
