@@ -75,14 +75,14 @@ std::string modeColour(size_t i) {
 // ---- metrics.csv / metrics.json ---------------------------------------------------------
 
 std::string csvHeader() {
-    return "volume,grid,kernel,view,distance,zoom,mode,psnr_db,ssim,rmse,max_abs_error,seconds,reference_seconds,"
+    return "volume,grid,tf,kernel,view,distance,zoom,mode,psnr_db,ssim,rmse,max_abs_error,seconds,reference_seconds,"
            "points,splats,splat_fraction,image,error_image";
 }
 
 std::string metricsCsv(const StudyResult& study) {
     std::string out = csvHeader() + "\n";
     forEachRow(study, [&](const VolumeResult& vol, const KernelResult& k, const ViewResult& v, const ModeResult& m) {
-        out += vol.id + "," + csvField(vol.grid) + "," + k.kernel + "," + v.view.id + "," + fmt(v.view.distance, "%.9g") + "," +
+        out += vol.id + "," + csvField(vol.grid) + "," + csvField(vol.tf) + "," + k.kernel + "," + v.view.id + "," + fmt(v.view.distance, "%.9g") + "," +
                fmt(v.view.zoom(), "%.9g") + "," + m.mode + "," + psnrText(m.metrics.psnr) + "," +
                fmt(m.metrics.ssim, "%.6f") + "," + fmt(m.metrics.rmse, "%.6g") + "," +
                fmt(m.metrics.maxAbsError, "%.6g") + "," + fmt(m.seconds, "%.6f") + "," +
@@ -104,13 +104,15 @@ nlohmann::ordered_json metricsJson(const StudyResult& study) {
     j["settings"] = study.settings;
     nlohmann::ordered_json volumes = nlohmann::ordered_json::array();
     for (const VolumeResult& vol : study.volumes)
-        volumes.push_back({{"id", vol.id}, {"path", vol.path}, {"grid", vol.grid}, {"active_voxels", vol.activeVoxels}});
+        volumes.push_back({{"id", vol.id}, {"path", vol.path}, {"grid", vol.grid}, {"tf", vol.tf},
+                           {"active_voxels", vol.activeVoxels}});
     j["volumes"] = volumes;
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     forEachRow(study, [&](const VolumeResult& vol, const KernelResult& k, const ViewResult& v, const ModeResult& m) {
         nlohmann::ordered_json r;
         r["volume"] = vol.id;
         r["grid"] = vol.grid;
+        r["tf"] = vol.tf;
         r["kernel"] = k.kernel;
         r["view"] = v.view.id;
         r["view_label"] = v.view.label;
@@ -407,7 +409,7 @@ std::string reportHtml(const StudyResult& study) {
     for (const VolumeResult& vol : study.volumes) {
         s << "<section id=\"vol-" << htmlEscape(vol.id) << "\">\n<h2>" << htmlEscape(vol.id) << "</h2>\n<p class=\"meta\">"
           << htmlEscape(vol.path) << ", grid '" << htmlEscape(vol.grid) << "', " << vol.activeVoxels
-          << " active voxels</p>\n";
+          << " active voxels, transfer function <code>" << htmlEscape(vol.tf) << "</code></p>\n";
         for (const KernelResult& k : vol.kernels) {
             s << "<h3>kernel " << htmlEscape(k.kernel) << "</h3>\n" << plotsHtml(study, vol, k);
             for (const ViewResult& v : k.views) s << viewHtml(study, v);

@@ -47,13 +47,14 @@ struct VolumeResult {
     std::string path;  ///< as given on the command line
     std::string grid;
     uint64_t activeVoxels = 0;
+    std::string tf;  ///< its transfer function (preset or file)
     std::vector<KernelResult> kernels;
 };
 
 struct StudyResult {
     std::string command;  ///< the command line that made it
     int width = 0, height = 0, spp = 0;
-    std::string tf;
+    std::string tf;  ///< the transfer function of every volume, or "per volume"
     std::vector<std::string> modes, kernels;
     nlohmann::json settings;  ///< the shared render settings (RenderSettings::toJson, no mode or distance)
     std::vector<VolumeResult> volumes;

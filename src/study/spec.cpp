@@ -25,7 +25,7 @@ const std::map<std::string, std::pair<const char*, Kind>>& keys() {
         {"kernels", {"--kernels", Kind::Words}}, {"views", {"--views", Kind::Words}},
         {"distances", {"--distances", Kind::Numbers}}, {"base", {"--base", Kind::Number}},
         {"size", {"--size", Kind::Size}},        {"spp", {"--spp", Kind::Integer}},
-        {"tf", {"--tf", Kind::Word}},            {"grid", {"--grid", Kind::Word}},
+        {"tf", {"--tf", Kind::Word}},            {"tfs", {"--tfs", Kind::Words}},            {"grid", {"--grid", Kind::Word}},
         {"threshold", {"--threshold", Kind::Number}}, {"lod", {"--lod", Kind::Number}},
         {"fov", {"--fov", Kind::Number}},        {"footprint", {"--footprint", Kind::Word}},
         {"filter_order", {"--filter-order", Kind::Word}}, {"subpixels", {"--subpixels", Kind::Integer}}};

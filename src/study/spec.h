@@ -5,7 +5,8 @@
 // the same flags are checked (values, ranges, modes, kernels) by one parser. Format:
 //   {"volumes": ["a.vdb", "b.vdb"], "modes": ["hybrid", "splat"], "kernels": ["gaussian"],
 //    "views": ["standard", "ladder"], "base": 1, "distances": [2, 0.5], "size": [160, 160],
-//    "spp": 16, "tf": "grey", "grid": "density", "threshold": 1, "lod": 1.25, "fov": 30,
+//    "spp": 16, "tf": "grey" (or "tfs": ["grey", "ct-bone"], one per volume), "grid": "density",
+//    "threshold": 1, "lod": 1.25, "fov": 30,
 //    "footprint": "auto", "filter_order": "postfilter", "subpixels": 1}
 // Every key is optional except "volumes" (a non-empty array of paths; relative paths are
 // relative to the working directory, as on the command line).

@@ -416,6 +416,31 @@ TEST_F(StudyCli, StudyFileRunsAndIsValidatedLikeFlags) {
     EXPECT_FALSE(fs::exists(never));
 }
 
+TEST_F(StudyCli, OneTransferFunctionPerVolume) {
+    const std::string second = out("ball.vdb"), dir = out("tfs");
+    ASSERT_EQ(test::runVdbsplat("generate sphere --res 12 -o '" + second + "'", local_.dir()).rc, 0);
+    const CliResult r = study("'" + second + "' -o '" + dir + "' --tfs grey,fire --modes hybrid --distances 1 --size 24x24 --spp 1");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const auto csv = lines(slurp(dir + "/metrics.csv"));
+    ASSERT_EQ(csv.size(), 3u);
+    auto col = columns(csv[0]);
+    EXPECT_EQ(fields(csv[1])[col["tf"]], "grey");
+    EXPECT_EQ(fields(csv[2])[col["tf"]], "fire");
+    // grey is grey; fire is not.
+    const Image g = readImage(dir + "/images/sphere/gaussian/d1/reference.exr");
+    const Image f = readImage(dir + "/images/ball/gaussian/d1/reference.exr");
+    const auto& gc = g.at(12, 12);
+    const auto& fc = f.at(12, 12);
+    EXPECT_NEAR(gc.x, gc.z, 1e-5);
+    EXPECT_GT(std::abs(fc.x - fc.z), 1e-3);
+    const std::string o = " -o '" + out("never-tfs") + "' --size 24x24";
+    test::expectOneLineError(study("'" + second + "' --tfs grey" + o), "--tfs: 1 transfer functions for 2 volumes");
+    test::expectOneLineError(study("--tfs grey --tf grey" + o), "--tfs: not with --tf");
+    test::expectOneLineError(study("--tfs nosuch" + o), "--tfs: unknown transfer function");
+    test::expectOneLineError(study("--tfs ''" + o), "--tfs: empty item");
+    EXPECT_FALSE(fs::exists(out("never-tfs")));
+}
+
 /// The value of attribute @p name of the element with id="selfcheck" in a DOM dump ("" if absent).
 std::string selfcheck(const std::string& dom, const std::string& name) {
     const size_t p = dom.find("id=\"selfcheck\"");

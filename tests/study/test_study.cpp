@@ -120,7 +120,7 @@ StudyResult sampleStudy() {
     s.tf = "grey";
     s.modes = {"hybrid", "point"};
     s.kernels = {"gaussian"};
-    VolumeResult vol{"sphere", "a<b>.vdb", "density", 100, {}};
+    VolumeResult vol{"sphere", "a<b>.vdb", "density", 100, "grey", {}};
     KernelResult k{"gaussian", {}};
     for (const View& v : standardViews()) {
         ViewResult vr;
@@ -156,7 +156,7 @@ TEST(StudyReport, CsvAndJson) {
     EXPECT_NE(csv.find(",point,38.00,"), std::string::npos);
     StudyResult odd = s;
     odd.volumes[0].grid = "a,\"b\"";
-    EXPECT_NE(metricsCsv(odd).find("\nsphere,\"a,\"\"b\"\"\",gaussian,"), std::string::npos) << metricsCsv(odd);
+    EXPECT_NE(metricsCsv(odd).find("\nsphere,\"a,\"\"b\"\"\",grey,gaussian,"), std::string::npos) << metricsCsv(odd);
     const auto j = metricsJson(s);
     ASSERT_EQ(j["rows"].size(), 6u);
     EXPECT_TRUE(j["rows"][0]["psnr_db"].is_null());
