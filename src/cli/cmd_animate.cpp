@@ -35,6 +35,7 @@
 #include "cli/commands.h"
 #include "cli/interrupt.h"
 #include "cli/render_flags.h"
+#include "volume/emission.h"
 #include "image/image.h"
 #include "metrics/metrics.h"
 #include "render/render.h"
@@ -377,7 +378,8 @@ int runAnimate(const Argv& argv) {
     valueFlags.insert({"-o", "--from", "--to", "--frames", "--orbit", "--path", "--fps", "--format"});
     const Args args(argv, valueFlags, {"--show-primitives", "--resume", "--force", "--reference", "--mp4"});
     if (args.wantsHelp()) {
-        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp;
+        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp << "\nemission (docs/emission.md):\n"
+                  << kEmissionHelp;
         return 0;
     }
     Options o = optionsFrom(args);
@@ -395,7 +397,7 @@ int runAnimate(const Argv& argv) {
     if (o.settings.threads > 0)
         threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.settings.threads);
     const TransferFunction tf = transferFunctionFor(o.settings);
-    const Volume volume = loadVolume(o.input, o.settings.gridName);
+    const Volume volume = loadVolumeWithEmission(o.input, o.settings.gridName, o.settings.emission.grid);
     const std::vector<Frame> frames = framesFor(o, volume);
     const size_t M = frames.size();
 

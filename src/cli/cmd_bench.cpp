@@ -26,6 +26,7 @@
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "cli/render_flags.h"
+#include "volume/emission.h"
 #include "render/render.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -159,6 +160,7 @@ Options optionsFrom(const Args& args) {
         s.camera.up = {u[0], u[1], u[2]};
     }
     s.shading = shadingFromFlags(args);
+    s.emission = emissionFromFlags(args);
     if (auto v = args.get("--runs")) o.runs = int(parseInt(*v, "--runs", 1, kMaxRuns));
     if (auto v = args.get("--warmup")) o.warmup = int(parseInt(*v, "--warmup", 0, kMaxWarmup));
     if (auto v = args.get("--modes")) o.modes = parseModes(*v);
@@ -173,6 +175,7 @@ Options optionsFrom(const Args& args) {
         std::error_code ec;
         if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) throw Error(*o.json + ": folder does not exist");
         checkOutputPath(*o.json);  // a directory or dangling link fails before the benchmark
+        checkNotAnInput(*o.json, o.input, "--json");
     }
     return o;
 }
@@ -218,9 +221,11 @@ int runBench(const Argv& argv) {
                                      "--modes",     "--distances", "--threshold", "--lod", "--simd",
                                      "--footprint", "--filter-order", "--subpixels", "--json", "--view-dir", "--up"};
     valueFlags.insert(shadingValueFlags().begin(), shadingValueFlags().end());
+    valueFlags.insert(emissionValueFlags().begin(), emissionValueFlags().end());
     const Args args(argv, valueFlags, {"-v"});
     if (args.wantsHelp()) {
-        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp;
+        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp << "\nemission (docs/emission.md):\n"
+                  << kEmissionHelp;
         return 0;
     }
     const Options o = optionsFrom(args);
@@ -233,7 +238,7 @@ int runBench(const Argv& argv) {
     const unsigned machine = std::thread::hardware_concurrency();
 
     const TransferFunction tf = TransferFunction::fromSpec(o.base.transferFunction);
-    const Volume volume = loadVolume(o.input, o.base.gridName);
+    const Volume volume = loadVolumeWithEmission(o.input, o.base.gridName, o.base.emission.grid);
     for (double d : o.distances) cameraFor(volume, o.settingsFor(d, RenderMode::Hybrid));  // validates before the work
 
     if (std::find(o.modes.begin(), o.modes.end(), RenderMode::Reference) != o.modes.end())

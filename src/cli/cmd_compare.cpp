@@ -86,7 +86,10 @@ int runCompare(const Argv& argv) {
     const auto& pos = args.positionals();
     if (pos.size() != 2)
         throw Error("compare needs IMAGE and REFERENCE, got " + std::to_string(pos.size()) + " file(s) (see --help)");
-    if (const auto json = args.get("--json")) checkOutputPath(*json);
+    if (const auto json = args.get("--json")) {
+        checkOutputPath(*json);
+        for (const std::string& input : pos) checkNotAnInput(*json, input, "--json");
+    }
     const Image image = readChecked(pos[0]);
     const Image reference = readChecked(pos[1]);
     if (image.width != reference.width || image.height != reference.height)

@@ -32,15 +32,15 @@ const char* kHelp =
     "base64 or appended data, zlib-compressed or not), anything else is headerless raw (x fastest,\n"
     "then y, then z; plain or gzip-compressed). Files are streamed, never read whole (except the\n"
     "XML of a .vti with inline data). NRRD and VTI keep their spacing, origin and directions in\n"
-    "the grid's transform; `render` needs cubic voxels (rotations are fine).\n"
+    "the grid's transform; `render` takes any voxel shape and affine transform.\n"
     "\n"
     "options:\n"
     "  -o OUT.vdb            output file (written atomically)\n"
     "  --dims X,Y,Z          raw only: voxel counts, each 1..65536; the file must hold exactly X*Y*Z voxels\n"
     "  --type T              raw only: uint8 | int16 | uint16 | float32 | float64 (little-endian);\n"
     "                        integers are normalised (/255, /32767, /65535), floats are kept\n"
-    "  --spacing SX,SY,SZ    raw only: voxel size in world units, 1e-4..1e6 (default 1,1,1); must be\n"
-    "                        uniform (non-uniform spacing is refused: the renderer needs cubic voxels)\n"
+    "  --spacing SX,SY,SZ    raw only: voxel size along x, y, z in world units, each 1e-4..1e6\n"
+    "                        (default 1,1,1); anisotropic voxels (e.g. 1,1,2.5) render as ellipsoids\n"
     "  --array NAME          .vti only: the PointData array to read (default: the active Scalars,\n"
     "                        else the first one-component array)\n"
     "  --threshold T         a voxel is active iff its normalised value is > T (default 0:\n"
@@ -71,7 +71,7 @@ RawSpec specFrom(const Args& args, const ConvertOptions& options) {
     RawSpec spec;
     spec.dims = parseDims(args.require("--dims"), "--dims");
     spec.type = parseRawType(args.require("--type"), "--type");
-    if (auto s = args.get("--spacing")) spec.spacing = parseUniformSpacing(*s, "--spacing");
+    if (auto s = args.get("--spacing")) spec.spacing = parseSpacing(*s, "--spacing");
     spec.threshold = options.threshold;
     spec.maxVoxels = options.maxVoxels;
     return spec;
@@ -107,6 +107,7 @@ int runConvert(const Argv& argv) {
     const std::string out = args.require("-o");
     const ConvertOptions options = optionsFrom(args);
     checkRegularOutputPath(out, "-o");
+    checkNotAnInput(out, in, "-o");
     const auto start = std::chrono::steady_clock::now();
     RawStats stats;
     auto grid = convert(args, in, options, stats);

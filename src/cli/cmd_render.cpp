@@ -13,6 +13,7 @@
 #include "cli/commands.h"
 #include "cli/interrupt.h"
 #include "cli/render_flags.h"
+#include "volume/emission.h"
 #include "image/image.h"
 #include "render/render.h"
 #include "util/atomic_file.h"
@@ -101,15 +102,17 @@ int runRender(const Argv& argv) {
     valueFlags.insert({"-o", "--stats"});
     const Args args(argv, valueFlags, {"-v", "--show-primitives"});
     if (args.wantsHelp()) {
-        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp;
+        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp << "\nemission (docs/emission.md):\n"
+                  << kEmissionHelp;
         return 0;
     }
     const std::string input = args.onePositional("input .vdb file");
     const std::string output = args.require("-o");
     RenderSettings settings = settingsFromFlags(args);
     checkImagePath(output);
+    checkNotAnInput(output, input, "-o");
     const auto statsPath = args.get("--stats");
-    if (statsPath) checkStatsPath(*statsPath, output);
+    if (statsPath) checkStatsPath(*statsPath, output), checkNotAnInput(*statsPath, input, "--stats");
 
     InterruptGuard guard;  // before loading: a Ctrl-C then stops the render before it starts
     std::unique_ptr<tbb::global_control> threads;
@@ -117,7 +120,7 @@ int runRender(const Argv& argv) {
         threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
 
     const TransferFunction tf = transferFunctionFor(settings);
-    const Volume volume = loadVolume(input, settings.gridName);
+    const Volume volume = loadVolumeWithEmission(input, settings.gridName, settings.emission.grid);
     checkVoxelBudget(volume, settings);
     resolveLookAt(args, volume, settings);
     const Camera camera = cameraFor(volume, settings);  // validates eye/look-at/up before the work

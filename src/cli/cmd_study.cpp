@@ -45,6 +45,7 @@
 #include "util/atomic_file.h"
 #include "util/error.h"
 #include "util/parse.h"
+#include "volume/emission.h"
 
 namespace vdbsplat::cli {
 
@@ -89,7 +90,8 @@ const char* kHelp =
     "render flags (as vdbsplat render; the same for every mode and view):\n"
     "  --grid NAME, --tf PRESET|FILE, --fov DEG, --up X,Y,Z, --view-dir X,Y,Z, --threshold PX,\n"
     "  --lod PX, --simd on|off, --footprint P, --filter-order O, --subpixels K, --tables DIR,\n"
-    "  --max-voxels N, --show-primitives, --threads N (see vdbsplat render --help)\n"
+    "  --max-voxels N, --show-primitives, --threads N, and the shading and emission flags below\n"
+    "  (see vdbsplat render --help)\n"
     "\n"
     "Ctrl-C or SIGTERM stops within the render under way (a second one stops at once): the\n"
     "finished renders stay, nothing is half-written, exit 1; run again with --resume.\n"
@@ -452,7 +454,8 @@ std::vector<LoadedVolume> loadVolumes(const Options& o) {
         std::error_code ec;
         const std::string canon = fs::weakly_canonical(o.inputs[i], ec).string();
         if (!seen.insert(canon).second) throw Error(o.inputs[i] + ": given more than once");
-        LoadedVolume lv{o.inputs[i], ids[i], loadVolume(o.inputs[i], o.kernels.front().settings.gridName), {},
+        const RenderSettings& s = o.kernels.front().settings;
+        LoadedVolume lv{o.inputs[i], ids[i], loadVolumeWithEmission(o.inputs[i], s.gridName, s.emission.grid), {},
                         o.tfs[i], transferFunctionOf(o, i)};
         lv.identity = volumeIdentity(o.inputs[i], lv.volume);
         for (const KernelPlan& k : o.kernels) checkVoxelBudget(lv.volume, k.settings);
@@ -611,7 +614,8 @@ Options optionsWithSpec(const Args& args, const std::map<std::string, std::strin
 int runStudy(const Argv& argv) {
     const Args given(argv, studyValueFlags(), kSwitches);
     if (given.wantsHelp()) {
-        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp;
+        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp << "\nemission (docs/emission.md):\n"
+                  << kEmissionHelp;
         return 0;
     }
     std::map<std::string, std::string> fromSpec;

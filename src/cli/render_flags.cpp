@@ -12,8 +12,42 @@ const std::set<std::string>& renderValueFlags() {
                                              "--threads", "--spp",      "--threshold", "--lod",   "--footprint",
                                              "--tables",  "--simd", "--max-voxels", "--filter-order", "--subpixels", "--shading",
                                              "--ambient", "--diffuse",  "--specular",  "--shininess",
-                                             "--light",   "--gradient-opacity"};
+                                             "--light",   "--gradient-opacity", "--emission", "--emission-map",
+                                             "--emission-scale", "--kelvin"};
     return flags;
+}
+
+const std::set<std::string>& emissionValueFlags() {
+    static const std::set<std::string> flags{"--emission", "--emission-map", "--emission-scale", "--kelvin"};
+    return flags;
+}
+
+const char* const kEmissionHelp =
+    "  --emission GRID    add the emission of scalar grid GRID of the same file (e.g. temperature,\n"
+    "                     flame; same transform as the density grid) on the density's kernels\n"
+    "  --emission-map M   blackbody (default): value -> Kelvin (--kelvin) -> Planck colour, brightness\n"
+    "                     (T^4 - LO^4)/(HI^4 - LO^4); or a transfer function (preset or JSON file) whose\n"
+    "                     emission sigma*c is used without its extinction\n"
+    "  --emission-scale K emitted radiance per voxel length at the map's brightest value (default 1)\n"
+    "  --kelvin LO,HI     blackbody: Kelvin at normalised value 0 and 1 (default 1500,6500)\n";
+
+EmissionSettings emissionFromFlags(const Args& args) {
+    EmissionSettings e;
+    if (auto v = args.get("--emission")) {
+        if (v->empty()) throw Error("--emission: expected a grid name, got ''");
+        e.grid = *v;
+    }
+    for (const char* flag : {"--emission-map", "--emission-scale", "--kelvin"})
+        if (args.has(flag) && !e.active()) throw Error(std::string(flag) + ": needs --emission GRID");
+    if (auto v = args.get("--emission-map")) e.map = *v;
+    if (auto v = args.get("--emission-scale")) e.scale = parseDouble(*v, "--emission-scale");
+    if (auto v = args.get("--kelvin")) {
+        if (e.map != "blackbody") throw Error("--kelvin: only for --emission-map blackbody");
+        const auto k = parseDoubleList(*v, "--kelvin", 2);
+        e.kelvinLo = k[0], e.kelvinHi = k[1];
+    }
+    e.validate();
+    return e;
 }
 
 const std::set<std::string>& shadingValueFlags() {
@@ -88,6 +122,7 @@ RenderSettings settingsFromFlags(const Args& args) {
     }
     s.showPrimitives = args.has("--show-primitives");
     s.shading = shadingFromFlags(args);
+    s.emission = emissionFromFlags(args);
     if (auto v = args.get("--tables")) {
         if (v->empty()) throw Error("--tables: expected a directory, got ''");
         s.tablesDir = *v;

@@ -25,6 +25,17 @@ const std::set<std::string>& shadingValueFlags();
 /// Help lines for the shading flags, shared by render, animate and bench.
 extern const char* const kShadingHelp;
 
+/// The emission flags (--emission, --emission-map, --emission-scale, --kelvin), part of
+/// renderValueFlags(); `bench` adds them to its own set.
+const std::set<std::string>& emissionValueFlags();
+
+/// Help lines for the emission flags (docs/emission.md), shared by render, animate and bench.
+extern const char* const kEmissionHelp;
+
+/// @brief The validated emission settings the emission flags in @p args describe.
+/// @throw Error naming the first bad flag (a bad value, or a map flag without --emission).
+EmissionSettings emissionFromFlags(const Args& args);
+
 /// @brief The validated shading settings the shading flags in @p args describe.
 /// @throw Error naming the first bad flag (a bad value, or a lighting flag without --shading).
 ShadingSettings shadingFromFlags(const Args& args);

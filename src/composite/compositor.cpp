@@ -88,8 +88,12 @@ struct TileCompositor::SlabBuffer {
 TileCompositor::TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact)
     : width_(width), height_(height), tilesX_((width + kTileSize - 1) / kTileSize),
       tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact),
-      color_(size_t(width) * height, glm::vec3(0.f)), transmittance_(size_t(width) * height, 1.f),
+      color_(size_t(width) * height), transmittance_(size_t(width) * height),  // filled below, in parallel
       liveCount_(size_t(tilesX_) * tilesY_) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, color_.size(), 16384), [&](const tbb::blocked_range<size_t>& r) {
+        std::fill(color_.begin() + ptrdiff_t(r.begin()), color_.begin() + ptrdiff_t(r.end()), glm::vec3(0.f));
+        std::fill(transmittance_.begin() + ptrdiff_t(r.begin()), transmittance_.begin() + ptrdiff_t(r.end()), 1.f);
+    });
     for (int ty = 0; ty < tilesY_; ++ty)
         for (int tx = 0; tx < tilesX_; ++tx)
             liveCount_[size_t(ty) * tilesX_ + tx] = (std::min(width_, (tx + 1) * kTileSize) - tx * kTileSize) *
@@ -105,7 +109,9 @@ bool TileCompositor::hidden(int x0, int y0, int x1, int y1) const {
 
 Image TileCompositor::image() const {
     Image image(width_, height_);
-    for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = glm::vec4(color_[i], 1.f - transmittance_[i]);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, image.pixels.size(), 16384), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) image.pixels[i] = glm::vec4(color_[i], 1.f - transmittance_[i]);
+    });
     return image;
 }
 
@@ -420,6 +426,19 @@ void TileCompositor::drawSplatTables(const TileRecord& p, const ExactIndexMap& m
 
 void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
     const Camera& camera = *exact_.camera;
+    if (exact_.shape && !exact_.shape->sphere) {  // an ellipsoid at the eye: the exact half-ray integral
+        const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
+        const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
+        const glm::dvec3 c(p.viewPos);
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                const int i = px.local(x, y);
+                if (!px.live(i)) continue;
+                const double tau = p.sigma * ellipsoidHalfRayDeposit(*exact_.shape, c, camera.viewRay(PixelCoord(x + 0.5, y + 0.5)));
+                if (tau > 0.0) px.over(i, float(tau), p.color);
+            }
+        return;
+    }
     const double h = exact_.voxelSize;
     const SphereProjection sphere = projectSphere(camera, ViewPoint(p.viewPos), Kernel::kRadius * h);
     // Recomputed from the float view position: a borderline sphere may no longer be an

@@ -19,6 +19,7 @@
 
 #include "composite/primitive.h"
 #include "footprint/ellipse.h"
+#include "footprint/ellipsoid.h"
 #include "footprint/prefilter.h"
 #include "footprint/tables.h"
 #include "image/image.h"
@@ -40,6 +41,9 @@ struct ExactContext {
     bool vector = true;
     /// The low-pass folded into kernels recomputed per tile (px²; as ProjectionContext).
     double prefilterVariance = kPrefilterVariance;
+    /// The kernels' shape in view space (footprint/ellipsoid.h); null or a sphere: spheres.
+    /// Ellipsoid kernels at the eye (NearEye) take the exact index-space half-ray integral.
+    const KernelShape* shape = nullptr;
 };
 
 /// Primitives composite() dropped because every tile they touch is already opaque.

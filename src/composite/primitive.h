@@ -28,7 +28,10 @@ enum class PrimitiveKind : uint8_t {
 };
 
 struct Primitive {
+    // What the compositor's key pass and gather read comes first (two cache lines; the
+    // exact-index map and the recompute fields after them are read only for their kinds).
     PrimitiveKind kind = PrimitiveKind::Culled;
+    bool hasExactMap = false;   ///< SplatExactIndex: exactMap is set
     int64_t slab = 0;           ///< depth slab (points of one slab are summed before compositing)
     float depth = 0.f;          ///< radial distance of the voxel centre (world units): the order
     uint32_t members = 1;       ///< active voxels it stands for (a level-of-detail aggregate: more)
@@ -45,7 +48,6 @@ struct Primitive {
                                 ///< reindex row through halfConeAngle()
     // SplatExactIndex: the exact d² as an affine map of the pixel (δ from `centre`), set up once
     ExactIndexMap exactMap;
-    bool hasExactMap = false;
     // SplatExact / NearEye (recomputed from these per tile; they are rare or a diagnostic)
     glm::vec3 viewPos{0.f};
     float sigma = 0.f;          ///< extinction per voxel length

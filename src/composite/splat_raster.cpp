@@ -8,6 +8,7 @@
 #include <hwy/contrib/math/math-inl.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "composite/opacity.h"
@@ -31,58 +32,69 @@ inline bool rowChord(const SplatRaster& s, float dy, int& xa, int& xb) {
     return xa <= xb;
 }
 
-void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) {
+/// T·α of the splat at pixel offsets (dx, dy) from its centre, for the lanes of @p mask (which
+/// the exact index narrows to d² < 1): τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h),
+/// α = 1 − e^{−τ}.
+template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
+HWY_INLINE V OpacityTimesT(D d, const SplatRaster& s, V dx, V dy, V i2, V T, M& mask) {
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.f), two = hn::Set(d, 2.f);
+    V t;
+    if (s.exactIndex) {  // d² = |w|² / |v|² / r², w = c × v (DESIGN §3; ExactIndexMap::d2)
+        const auto affine = [&](const glm::vec3& base, const glm::vec3& perY, const glm::vec3& perX, int c) {
+            return hn::MulAdd(dx, hn::Set(d, perX[c]), hn::MulAdd(dy, hn::Set(d, perY[c]), hn::Set(d, base[c])));
+        };
+        const V wx = affine(s.map.A, s.map.C, s.map.B, 0), wy = affine(s.map.A, s.map.C, s.map.B, 1),
+                wz = affine(s.map.A, s.map.C, s.map.B, 2);
+        const V vx = affine(s.map.v0, s.map.vy, s.map.vx, 0), vy = affine(s.map.v0, s.map.vy, s.map.vx, 1),
+                vz = affine(s.map.v0, s.map.vy, s.map.vx, 2);
+        const V w2 = hn::MulAdd(wx, wx, hn::MulAdd(wy, wy, hn::Mul(wz, wz)));
+        const V v2 = hn::MulAdd(vx, vx, hn::MulAdd(vy, vy, hn::Mul(vz, vz)));
+        t = hn::Mul(hn::Div(w2, v2), hn::Set(d, s.map.invR2));
+        mask = hn::And(mask, hn::Lt(t, one));
+    } else {
+        t = i2;
+    }
+    t = hn::Min(hn::Max(t, zero), one);
+    const V x = hn::MulSub(two, t, one);
+    V p = hn::Set(d, s.coef[FootprintPolynomials::kDegree]);
+#pragma GCC unroll 16
+    for (int j = FootprintPolynomials::kDegree - 1; j >= 0; --j) p = hn::MulAdd(p, x, hn::Set(d, s.coef[size_t(j)]));
+    const V tau = hn::Max(hn::Mul(hn::Mul(hn::Set(d, s.scale), hn::Sqrt(hn::Sub(one, t))), p), zero);
+    const V alpha = hn::Neg(hn::Expm1(d, hn::Neg(tau)));  // 1 − e^{−τ}
+    return hn::Mul(T, alpha);
+}
+
+/// i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V IndexSquared(D d, const SplatRaster& s, V dx, V dy) {
+    return hn::MulAdd(hn::Mul(hn::Set(d, s.qxx), dx), dx,
+                      hn::Mul(hn::MulAdd(hn::Set(d, 2.f * s.qxy), dx, hn::Mul(hn::Set(d, s.qyy), dy)), dy));
+}
+
+/// One row, one vector per n pixels of its chord.
+void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
     const hn::CappedTag<float, kStride> d;
     const int n = int(hn::Lanes(d));
     using V = hn::Vec<decltype(d)>;
     const V lane = hn::Iota(d, 0.5f);  // pixel centre offsets 0.5, 1.5, …
-    const V zero = hn::Zero(d), one = hn::Set(d, 1.f), two = hn::Set(d, 2.f);
-    const V qxx = hn::Set(d, s.qxx), qxy2 = hn::Set(d, 2.f * s.qxy), qyy = hn::Set(d, s.qyy);
-    const V scale = hn::Set(d, s.scale), eps = hn::Set(d, s.epsilon);
+    const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon);
     const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
     for (int y = s.y0; y <= s.y1; ++y) {
         const float dyf = float(y) + 0.5f - s.cy;
         int xa, xb;
         if (!rowChord(s, dyf, xa, xb)) continue;
         const V dy = hn::Set(d, dyf);
-        const V i2Row = hn::Mul(hn::Mul(qyy, dy), dy);  // Qyy dy²
         const V lo = hn::Set(d, float(xa)), hi = hn::Set(d, float(xb) + 0.75f);
-        // Exact index: the ray terms that depend on the row only (ExactIndexMap::d2).
-        const glm::vec3 wRow = s.map.A + dyf * s.map.C, vRow = s.map.v0 + dyf * s.map.vy;
         const int row = (y - tile.y0) * kStride;
         for (int c = (xa - tile.x0) / n * n; c <= xb - tile.x0; c += n) {
             const V xPix = hn::Add(hn::Set(d, float(tile.x0 + c)), lane);  // pixel centres
             const V dx = hn::Sub(xPix, hn::Set(d, s.cx));
-            // i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²
-            const V i2 = hn::MulAdd(hn::Mul(qxx, dx), dx, hn::MulAdd(hn::Mul(qxy2, dx), dy, i2Row));
+            const V i2 = IndexSquared(d, s, dx, dy);
             float* pt = tile.T + row + c;
             const V T = hn::Load(d, pt);
             auto mask = hn::And(hn::And(hn::Ge(xPix, lo), hn::Lt(xPix, hi)), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
             if (hn::AllFalse(d, mask)) continue;
-            V t;
-            if (s.exactIndex) {  // d² = |w|² / |v|² / r², w = c × v (DESIGN §3)
-                const V wx = hn::MulAdd(dx, hn::Set(d, s.map.B.x), hn::Set(d, wRow.x));
-                const V wy = hn::MulAdd(dx, hn::Set(d, s.map.B.y), hn::Set(d, wRow.y));
-                const V wz = hn::MulAdd(dx, hn::Set(d, s.map.B.z), hn::Set(d, wRow.z));
-                const V vx = hn::MulAdd(dx, hn::Set(d, s.map.vx.x), hn::Set(d, vRow.x));
-                const V vy = hn::MulAdd(dx, hn::Set(d, s.map.vx.y), hn::Set(d, vRow.y));
-                const V vz = hn::MulAdd(dx, hn::Set(d, s.map.vx.z), hn::Set(d, vRow.z));
-                const V w2 = hn::MulAdd(wx, wx, hn::MulAdd(wy, wy, hn::Mul(wz, wz)));
-                const V v2 = hn::MulAdd(vx, vx, hn::MulAdd(vy, vy, hn::Mul(vz, vz)));
-                t = hn::Mul(hn::Div(w2, v2), hn::Set(d, s.map.invR2));
-                mask = hn::And(mask, hn::Lt(t, one));
-            } else {
-                t = i2;
-            }
-            t = hn::Min(hn::Max(t, zero), one);
-            // τ = scale·√(1 − t)·G(2t − 1), Horner (footprint_poly.h)
-            const V x = hn::MulSub(two, t, one);
-            V p = hn::Set(d, s.coef[FootprintPolynomials::kDegree]);
-#pragma GCC unroll 16
-            for (int j = FootprintPolynomials::kDegree - 1; j >= 0; --j) p = hn::MulAdd(p, x, hn::Set(d, s.coef[size_t(j)]));
-            const V tau = hn::Max(hn::Mul(hn::Mul(scale, hn::Sqrt(hn::Sub(one, t))), p), zero);
-            const V alpha = hn::Neg(hn::Expm1(d, hn::Neg(tau)));  // 1 − e^{−τ}
-            const V ta = hn::Mul(T, alpha);
+            const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
             float *pr = tile.R + row + c, *pg = tile.G + row + c, *pb = tile.B + row + c;
             hn::Store(hn::IfThenElse(mask, hn::MulAdd(ta, cr, hn::Load(d, pr)), hn::Load(d, pr)), d, pr);
             hn::Store(hn::IfThenElse(mask, hn::MulAdd(ta, cg, hn::Load(d, pg)), hn::Load(d, pg)), d, pg);
@@ -91,6 +103,97 @@ void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) {
         }
     }
 }
+
+#if HWY_TARGET != HWY_SCALAR
+/// A small splat on a 16-lane target: every row's chord fits in 8 pixels, so two rows share one
+/// vector (the lower half one row's 8 pixels from its chord's start, the upper half the next
+/// row's): half the vectors of DrawRowsWide, whose one vector per row leaves most lanes idle
+/// for a splat a few pixels wide. Same per-pixel operations, so the same values.
+template <class D>
+void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const int* rows, const int* starts,
+                  const int* xas, const int* xbs, int count) {
+    using V = hn::Vec<D>;
+    const hn::Half<D> dh;
+    using VH = hn::Vec<decltype(dh)>;
+    const VH laneH = hn::Iota(dh, 0.5f);
+    const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon);
+    const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
+    constexpr int kHalf = kStride / 2;
+    for (int k = 0; k < count; k += 2) {
+        const bool pair = k + 1 < count;
+        const int ka = k, kb = pair ? k + 1 : k;  // a lone last row: its upper half repeats it, masked off
+        const auto both = [&](float a, float b) { return hn::Combine(d, hn::Set(dh, b), hn::Set(dh, a)); };
+        const V xPix = hn::Combine(d, hn::Add(hn::Set(dh, float(tile.x0 + starts[kb])), laneH),
+                                   hn::Add(hn::Set(dh, float(tile.x0 + starts[ka])), laneH));
+        const V dx = hn::Sub(xPix, hn::Set(d, s.cx));
+        const V dy = both(float(rows[ka]) + 0.5f - s.cy, float(rows[kb]) + 0.5f - s.cy);
+        const V lo = both(float(xas[ka]), float(xas[kb])), hi = both(float(xbs[ka]) + 0.75f, float(xbs[kb]) + 0.75f);
+        const V i2 = IndexSquared(d, s, dx, dy);
+        const int offA = (rows[ka] - tile.y0) * kStride + starts[ka], offB = (rows[kb] - tile.y0) * kStride + starts[kb];
+        const auto load = [&](const float* base) { return hn::Combine(d, hn::LoadU(dh, base + offB), hn::LoadU(dh, base + offA)); };
+        const V T = load(tile.T);
+        auto mask = hn::And(hn::And(hn::Ge(xPix, lo), hn::Lt(xPix, hi)), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
+        if (!pair) mask = hn::And(mask, hn::FirstN(d, kHalf));
+        if (hn::AllFalse(d, mask)) continue;
+        const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
+        const auto store = [&](float* base, V value) {
+            hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
+            if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
+        };
+        const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
+        store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, cr, R), R));
+        store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, cg, G), G));
+        store(tile.B, hn::IfThenElse(mask, hn::MulAdd(ta, cb, B), B));
+        store(tile.T, hn::IfThenElse(mask, hn::Sub(T, ta), T));  // T·(1 − α)
+    }
+}
+
+#endif  // HWY_TARGET != HWY_SCALAR
+
+template <class D>
+void DrawSplatRowsFor(D d, const SplatRaster& s, const TileBuffers& tile) {
+#if HWY_TARGET != HWY_SCALAR
+    if constexpr (hn::MaxLanes(D()) == kStride) {
+        // Every row's chord at once (rowChord's arithmetic, one lane per row of the tile), then
+        // the rows with a chord, and whether an 8-pixel window from each chord's start holds it.
+        constexpr int kHalf = kStride / 2;
+        const hn::RebindToSigned<D> di;
+        const auto dy = hn::Sub(hn::Iota(d, float(s.y0) + 0.5f), hn::Set(d, s.cy));
+        const auto b = hn::Mul(hn::Set(d, s.qxy), dy);
+        const auto disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, s.qxx), hn::Sub(hn::Mul(hn::Mul(hn::Set(d, s.qyy), dy), dy), hn::Set(d, 1.f))));
+        const auto has = hn::And(hn::Gt(disc, hn::Zero(d)), hn::FirstN(d, size_t(s.y1 - s.y0 + 1)));
+        const auto root = hn::Sqrt(hn::Max(disc, hn::Zero(d)));
+        const auto base = hn::Set(d, s.cx - 0.5f), qxx = hn::Set(d, s.qxx);
+        const auto lo = hn::Add(base, hn::Div(hn::Sub(hn::Neg(b), root), qxx));
+        const auto hi = hn::Add(base, hn::Div(hn::Sub(root, b), qxx));
+        alignas(64) int32_t xaAll[kStride], xbAll[kStride];
+        hn::Store(hn::ConvertTo(di, hn::Max(hn::Floor(lo), hn::Set(d, float(s.x0)))), di, xaAll);
+        hn::Store(hn::ConvertTo(di, hn::Min(hn::Ceil(hi), hn::Set(d, float(s.x1)))), di, xbAll);
+        uint8_t hasBits[8] = {};
+        hn::StoreMaskBits(d, has, hasBits);
+        const unsigned rowsWithChord = unsigned(hasBits[0]) | unsigned(hasBits[1]) << 8;
+        int rows[kStride], starts[kStride], xas[kStride], xbs[kStride], count = 0;
+        bool narrow = true;
+        for (unsigned m = rowsWithChord; m != 0 && narrow; m &= m - 1) {
+            const int k = std::countr_zero(m), xa = xaAll[k], xb = xbAll[k];
+            if (xa > xb) continue;
+            if (xb - xa >= kHalf) narrow = false;
+            rows[count] = s.y0 + k, xas[count] = xa, xbs[count] = xb;
+            starts[count] = std::min(xa - tile.x0, kHalf);  // [start, start + 8) ⊇ [xa, xb] − x0, inside the row
+            ++count;
+        }
+        if (narrow) {
+            if (count > 0) DrawRowPairs(d, s, tile, rows, starts, xas, xbs, count);
+            return;
+        }
+    }
+#else
+    (void)d;
+#endif
+    DrawRowsWide(s, tile);
+}
+
+void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) { DrawSplatRowsFor(hn::CappedTag<float, kStride>(), s, tile); }
 
 }  // namespace HWY_NAMESPACE
 }  // namespace vdbsplat

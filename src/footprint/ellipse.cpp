@@ -72,7 +72,7 @@ SphereProjection projectSphere(const ViewPoint& c, double r, double f, const Pix
         return s;  // Behind: culled, all fields zero
     s.c = c, s.r = r, s.f = f, s.principal = principal;
     s.D = glm::length(c);
-    s.rho = std::hypot(c.x, c.y);
+    s.rho = std::sqrt(c.x * c.x + c.y * c.y);  // no overflow for view coordinates (hypot is a slow libm call)
     if (s.D <= r) {
         s.kind = SphereClass::EyeInside;
         s.sinAlpha = 1.0;

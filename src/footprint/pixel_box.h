@@ -27,8 +27,19 @@ struct PixelRange {
 /// Safe for infinite or huge boxes (clamped in double before the integer cast); NaN gives empty.
 inline PixelRange pixelRange(const PixelBox& box, int width, int height) {
     if (box.empty()) return {};
-    auto first = [](double lo, int n) { return (int)std::clamp(std::ceil(lo - 0.5), 0.0, (double)n); };
-    auto last = [](double hi, int n) { return (int)std::clamp(std::floor(hi - 0.5), -1.0, (double)n - 1.0); };
+    // ceil and floor commute with a clamp to integer bounds; after the clamp the value is finite
+    // and small, so they are an integer cast and a compare (std::ceil is a libm call on the
+    // x86-64 baseline, and this runs for every primitive).
+    auto first = [](double lo, int n) {
+        const double x = std::clamp(lo - 0.5, 0.0, (double)n);
+        const int i = (int)x;
+        return i + (double(i) < x ? 1 : 0);
+    };
+    auto last = [](double hi, int n) {
+        const double x = std::clamp(hi - 0.5, -1.0, (double)n - 1.0);
+        const int i = (int)x;
+        return i - (double(i) > x ? 1 : 0);
+    };
     return {first(box.lo.x, width), first(box.lo.y, height), last(box.hi.x, width), last(box.hi.y, height)};
 }
 

@@ -60,19 +60,26 @@ WindowCounts countWindow(std::span<const Primitive> window) {
 /// Streams, projects and composites @p volume onto @p camera's pixels.
 Image composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, const Tables& tables,
                 const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
-                const VoxelShader* shader, const RenderControl& control) {
+                const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
     StreamOptions streamOptions = settings.stream;
     streamOptions.lodCellPx = pass.lodPx;
     streamOptions.pointPrefilterVariance = pass.prefilterVariance;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point   ? INFINITY
                                  : settings.mode == RenderMode::Splat ? 0.0
                                                                       : pass.threshold;
-    VoxelStream stream(volume, camera, table, streamOptions, shader);
-    TileCompositor compositor(camera.width(), camera.height(), tables,
-                              ExactContext{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance});
-    const ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
-                                settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
-                                pass.prefilterVariance};
+    VoxelStream stream(volume, camera, table, streamOptions, shader, emission);
+    // The kernels' shape in view space (anisotropic or sheared voxels: ellipsoids).
+    // view = R·(world − eye), R's rows right, up, forward: M = R·A.
+    const glm::dmat3 worldToView = glm::transpose(glm::dmat3(camera.right(), camera.up(), camera.forward()));
+    KernelShape shape = KernelShape::of(worldToView * glm::dmat3(volume.indexToWorld));
+    shape.sphere = volume.isotropic;
+    ExactContext exact{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance};
+    exact.shape = &shape;
+    TileCompositor compositor(camera.width(), camera.height(), tables, exact);
+    ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
+                          settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
+                          pass.prefilterVariance};
+    ctx.shape = &shape;
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
     PrimitiveBuffer prims;
@@ -157,17 +164,17 @@ Image placed(const Image& part, int x0, int y0, int width, int height) {
 
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     const Tables& tables, const RenderSettings& settings, RenderStats& stats,
-                    const VoxelShader* shader, const RenderControl& control) {
+                    const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
     // Fixed costs follow the pixels the volume covers, not the image: the compositor, its
     // tiles and the postfilter see only that rectangle (a cropped camera: the same rays, so the
     // same image there, up to the float rounding of pixel coordinates); the rest is empty.
     if (settings.filterOrder == FilterOrder::Prefilter) {
         const ForwardPass pass{settings.threshold, settings.lodPx, kPrefilterVariance};
         const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance), 0);
-        if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control);
+        if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control, emission);
         const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
         const Image part = composite(volume, table, camera.cropped(crop->x0, crop->y0, w, h), tables, settings, pass,
-                                     stats, shader, control);
+                                     stats, shader, control, emission);
         return placed(part, crop->x0, crop->y0, camera.width(), camera.height());
     }
     // Postfilter: the same primitives (τ and the level of detail scaled to sub-pixels, so the
@@ -183,12 +190,12 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     const std::optional<PixelRange> crop =
         coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance), grid.border);
     if (!crop) {
-        const Image sub = composite(volume, table, fine, tables, settings, pass, stats, shader, control);
+        const Image sub = composite(volume, table, fine, tables, settings, pass, stats, shader, control, emission);
         return postfilterImage(sub, grid, camera.width(), camera.height());
     }
     const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
     const Camera fineCrop = fine.cropped(k * crop->x0, k * crop->y0, k * (w + 2 * grid.border), k * (h + 2 * grid.border));
-    const Image sub = composite(volume, table, fineCrop, tables, settings, pass, stats, shader, control);
+    const Image sub = composite(volume, table, fineCrop, tables, settings, pass, stats, shader, control, emission);
     return placed(postfilterImage(sub, grid, w, h), crop->x0, crop->y0, camera.width(), camera.height());
 }
 

@@ -8,14 +8,17 @@
 #include "image/image.h"
 #include "render/settings.h"
 #include "shading/shading_field.h"
+#include "volume/emission.h"
 #include "volume/grid.h"
 #include "volume/transfer_function.h"
 
 namespace vdbsplat {
 
 /// @brief Renders @p volume in settings.mode (Hybrid, Splat or Point).
+/// @p emission: each voxel's emission (nullptr: none; docs/emission.md).
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     const Tables& tables, const RenderSettings& settings, RenderStats& stats,
-                    const VoxelShader* shader = nullptr, const RenderControl& control = {});
+                    const VoxelShader* shader = nullptr, const RenderControl& control = {},
+                    const EmissionSource* emission = nullptr);
 
 }  // namespace vdbsplat

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "footprint/ellipse.h"
+#include "footprint/ellipsoid.h"
 #include "footprint/kernel.h"
 #include "footprint/screen_kernel.h"
 #include "pointfilter/point_filter.h"
@@ -14,6 +15,13 @@
 namespace vdbsplat {
 
 namespace {
+
+/// floor(x) for a finite x within ±2⁶² (a distance over a slab length): a cast and a compare,
+/// not a libm call.
+int64_t floorToInt64(double x) {
+    const int64_t i = int64_t(x);
+    return i - (double(i) > x ? 1 : 0);
+}
 
 /// --show-primitives: splats tinted red (Yuan et al. 2003, Figure 8a), points unchanged.
 glm::vec3 splatTint(const glm::vec3& c) {
@@ -73,15 +81,56 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, const ProjectionContext& c
     return p;
 }
 
+/// An ellipsoid kernel (footprint/ellipsoid.h): its exact silhouette widened by the low-pass,
+/// and the exact index-space ray–centre distance per pixel (an ExactIndexMap in index space),
+/// read by the compositor's exact-index path. τ = σ_world·L·F(d), L the world length per index
+/// length, taken along the centre ray (it varies by ~(anisotropy)·α over the footprint;
+/// docs/kernel.md, "Any voxel shape"); kernels at the eye take the exact half-ray integral.
+Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, const ProjectionContext& ctx) {
+    Primitive p;
+    const KernelShape& shape = *ctx.shape;
+    const EllipsoidProjection e = projectEllipsoid(shape, c, ctx.camera.focal(), ctx.camera.principal());
+    p.viewPos = glm::vec3(c);
+    p.sigma = sigma;
+    switch (e.kind) {
+        case SphereClass::Behind: return p;
+        case SphereClass::EyeInside:
+        case SphereClass::Straddles:
+            p.kind = PrimitiveKind::NearEye;
+            p.range = pixelRange(e.ellipse.bounds, ctx.camera.width(), ctx.camera.height());
+            break;
+        case SphereClass::Ellipse: {
+            const ScreenKernel kernel = makeScreenKernel(e.ellipse, ctx.prefilterVariance);
+            p.kind = PrimitiveKind::SplatExactIndex;
+            p.centre = glm::vec2(kernel.centre);
+            p.conic = glm::vec3(kernel.conic[0][0], kernel.conic[0][1], kernel.conic[1][1]);
+            p.scale = float(sigma / ctx.voxelSize * e.lengthScale * kernel.amplitude);  // σ_world·L·amplitude
+            p.sin2Alpha = float(e.ellipse.sinAlpha * e.ellipse.sinAlpha);
+            p.exactMap = makeEllipsoidIndexMap(kernel, e, shape, PixelCoord(p.centre));
+            p.hasExactMap = true;
+            p.range = pixelRange(kernel.bounds, ctx.camera.width(), ctx.camera.height());
+            break;
+        }
+    }
+    if (p.range.empty()) p.kind = PrimitiveKind::Culled;
+    return p;
+}
+
 }  // namespace
 
 Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx,
                        float spreadPx2) {
-    const double spacingPx = c.z > 0.0 ? ctx.voxelSize * ctx.camera.focal() / c.z : INFINITY;
+    const bool ellipsoid = ctx.shape && !ctx.shape->sphere;
+    // The projected voxel spacing h·f/z; for an ellipsoid its longest axis (a splat as soon as any
+    // axis is magnified) decides, and its projected spacing sets the point filter.
+    const double spacingPx = c.z > 0.0 ? (ellipsoid ? ctx.shape->sMax : ctx.voxelSize) * ctx.camera.focal() / c.z : INFINITY;
     const bool point = ctx.mode == RenderMode::Point ? c.z > 0.0
                        : ctx.mode == RenderMode::Splat ? false
                                                        : spacingPx < ctx.threshold;
-    Primitive p = point ? makePoint(c, sigma, spacingPx, spreadPx2, ctx) : makeSplat(c, sigma, ctx);
+    const double filterPx = ellipsoid && c.z > 0.0 ? ctx.shape->projectedSpacing() * ctx.camera.focal() / c.z : spacingPx;
+    Primitive p = point       ? makePoint(c, sigma, filterPx, spreadPx2, ctx)
+                  : ellipsoid ? makeEllipsoidSplat(c, sigma, ctx)
+                              : makeSplat(c, sigma, ctx);
     p.color = (!point && ctx.showPrimitives) ? splatTint(color) : color;
     return p;
 }
@@ -94,7 +143,7 @@ std::span<const Primitive> projectBatch(const VoxelBatch& batch, const Projectio
             Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
             p.members = batch.members[i];
             p.depth = batch.distance[i];
-            p.slab = std::clamp<int64_t>(int64_t(std::floor(batch.distance[i] / ctx.slabLength)), batch.slabBegin,
+            p.slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
                                          batch.slabEnd - 1);
             prims[i] = p;
         }

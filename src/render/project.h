@@ -10,6 +10,7 @@
 
 #include "camera/camera.h"
 #include "composite/primitive.h"
+#include "footprint/ellipsoid.h"
 #include "footprint/prefilter.h"
 #include "footprint/tables.h"
 #include "render/settings.h"
@@ -34,6 +35,11 @@ struct ProjectionContext {
     /// The screen low-pass V_h folded into every primitive (px²): kPrefilterVariance, or the
     /// sub-pixel grid's small one when the prefilter is applied after compositing (postfilter.h).
     double prefilterVariance = kPrefilterVariance;
+    /// The kernels' shape in view space (footprint/ellipsoid.h); null or a sphere: the sphere
+    /// paths. An ellipsoid (anisotropic or sheared voxels) decides point/splat by its longest
+    /// axis, filters points with its projected spacing, and is splatted through its exact
+    /// silhouette and the exact index-space distance (SplatExactIndex; --footprint does not apply).
+    const KernelShape* shape = nullptr;
 };
 
 /// @brief Projects every voxel of @p batch into the first batch.size() elements of @p prims

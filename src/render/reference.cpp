@@ -116,9 +116,11 @@ ActiveRegions::ActiveRegions(const openvdb::FloatGrid& grid) {
 }
 
 RayIntegrator::RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions,
-                             const ShadingField* shading)
+                             const ShadingField* shading, const EmissionSource* emission)
     : volume_(volume), table_(table), accessor_(volume.grid->getConstAccessor()),
       shading_(shading ? std::make_unique<ShadingField::Accessor>(shading->tree()) : nullptr),
+      emission_(emission),
+      emissionAccessor_(emission ? std::make_unique<EmissionSource::Accessor>(emission->accessor()) : nullptr),
       bins_(kRingSize),
       ownRegions_(regions ? nullptr : std::make_unique<ActiveRegions>(*volume.grid)),
       regions_(regions ? regions : ownRegions_.get()) {}
@@ -228,8 +230,9 @@ void RayIntegrator::gather(const glm::dvec3& o, const glm::dvec3& d, double tEnt
 }
 
 Classified RayIntegrator::classify(const openvdb::Coord& ijk, float value) {
-    const Classified cls = table_(value);
-    return shading_ ? applyShading(cls, shading_->getValue(ijk)) : cls;
+    Classified cls = table_(value);
+    if (shading_) cls = applyShading(cls, shading_->getValue(ijk));
+    return emission_ ? applyEmission(cls, emission_->at(*emissionAccessor_, ijk)) : cls;
 }
 
 namespace {
@@ -239,6 +242,8 @@ namespace {
 struct BinCompositor {
     std::vector<RayIntegrator::Bin>& bins;
     double tEnter;
+    /// World length per index length along the ray, over h (rayStretch): 1 for cubic voxels.
+    double stretch = 1.0;
     glm::dvec3 color{0.0};
     double transmittance = 1.0;
     int64_t next = 0;     // first bin not yet composited
@@ -266,7 +271,7 @@ struct BinCompositor {
         const double tStart = std::max(tc - halfChord, tEnter), tEnd = tc + halfChord;
         if (tEnd <= tStart) return;
         // ∫ N e^{−(ρ²+u²)/2s²} du = N e^{−ρ²/2s²} · s√(π/2) · ΔE(u)
-        const double amplitude = cls.sigma * Kernel::normalization() * kS * std::sqrt(std::numbers::pi / 2.0) *
+        const double amplitude = stretch * cls.sigma * Kernel::normalization() * kS * std::sqrt(std::numbers::pi / 2.0) *
                                  std::exp(-rho2 / (2.0 * kS * kS));
         const glm::dvec3 c(cls.color);
         int64_t j = binOf(tStart);
@@ -296,13 +301,22 @@ struct BinCompositor {
 
 }  // namespace
 
+/// The ray parameter t runs in index units along the unit index-space direction; σ_k·h (per
+/// voxel length) times ∫g dt is the optical depth when a unit of t is h world units (cubic
+/// voxels). For any affine voxel a unit of t is |ω|/|A⁻¹ω| world units along the world
+/// direction ω: the kernel's line integral is scaled by that over h (1 for cubes, exactly).
+static double rayStretch(const Volume& volume, const glm::dvec3& direction) {
+    if (volume.isotropic) return 1.0;
+    return glm::length(direction) / (glm::length(glm::dmat3(volume.worldToIndex) * direction) * volume.voxelSize);
+}
+
 glm::dvec4 RayIntegrator::integrate(const glm::dvec3& origin, const glm::dvec3& direction) {
     const glm::dvec3 o = glm::dvec3(volume_.worldToIndex * glm::dvec4(origin, 1.0));
     const glm::dvec3 d = glm::normalize(glm::dmat3(volume_.worldToIndex) * direction);
     double tEnter, tExit;
     if (!clip(o, d, tEnter, tExit)) return glm::dvec4(0.0);
     std::fill(bins_.begin(), bins_.end(), Bin{});
-    BinCompositor compositor{bins_, tEnter};
+    BinCompositor compositor{bins_, tEnter, rayStretch(volume_, direction)};
     gather(o, d, tEnter, tExit, compositor);
     compositor.compositeUpTo(compositor.filled + 1);
     return glm::dvec4(compositor.color, 1.0 - compositor.transmittance);
@@ -315,18 +329,19 @@ double RayIntegrator::opticalDepth(const glm::dvec3& origin, const glm::dvec3& d
     if (!clip(o, d, tEnter, tExit)) return 0.0;
     struct Visitor {
         RayIntegrator* self;
-        double tEnter, sum = 0.0;
+        double tEnter, stretch, sum = 0.0;
         void kernel(double tc, double rho2, const Classified& cls) {
-            sum += cls.sigma * Kernel::segmentIntegral(std::sqrt(rho2), tEnter - tc, kR);
+            sum += stretch * cls.sigma * Kernel::segmentIntegral(std::sqrt(rho2), tEnter - tc, kR);
         }
         bool sliceDone(double) { return true; }
-    } visitor{this, tEnter};
+    } visitor{this, tEnter, rayStretch(volume_, direction)};
     gather(o, d, tEnter, tExit, visitor);
     return visitor.sum;
 }
 
 Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
-                      RenderStats& stats, const ShadingField* shading, const RenderControl& control) {
+                      RenderStats& stats, const ShadingField* shading, const RenderControl& control,
+                      const EmissionSource* emission) {
     const auto start = std::chrono::steady_clock::now();
     const int n = std::max(1, int(std::ceil(std::sqrt(double(spp)) - 1e-9)));  // strata per axis
     stats.raysPerPixel = n * n;
@@ -358,7 +373,7 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
             return PixelCoord(px + (sx + hash01(px, py, 2 * s)) / n, py + (sy + hash01(px, py, 2 * s + 1)) / n);
         };
         tbb::parallel_for(tbb::blocked_range<int>(0, sh, 1), [&](const tbb::blocked_range<int>& rows) {
-            RayIntegrator integrator(volume, table, &regions, shading);
+            RayIntegrator integrator(volume, table, &regions, shading, emission);
             for (int r = rows.begin(); r < rows.end(); ++r) {
                 if (stopped.load(std::memory_order_relaxed) || (control.stop && control.stop())) {
                     stopped.store(true);

@@ -25,6 +25,7 @@
 #include "image/image.h"
 #include "render/settings.h"
 #include "shading/shading_field.h"
+#include "volume/emission.h"
 #include "volume/grid.h"
 #include "volume/transfer_function.h"
 
@@ -54,8 +55,9 @@ public:
     /// @p regions: the volume's ActiveRegions, shared by every integrator of a render; when
     /// null the integrator builds its own.
     /// @p shading: per-voxel shading factors applied after classification (nullptr: none).
+    /// @p emission: each voxel's emission, added after shading (nullptr: none; docs/emission.md).
     RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions = nullptr,
-                  const ShadingField* shading = nullptr);
+                  const ShadingField* shading = nullptr, const EmissionSource* emission = nullptr);
     /// @brief Premultiplied RGB and alpha = 1 − T of the ray from world point @p origin
     /// along world direction @p direction (any length), from the origin to infinity.
     glm::dvec4 integrate(const glm::dvec3& origin, const glm::dvec3& direction);
@@ -82,6 +84,8 @@ private:
     const ClassificationTable& table_;
     openvdb::FloatGrid::ConstAccessor accessor_;
     std::unique_ptr<ShadingField::Accessor> shading_;  ///< null when unshaded
+    const EmissionSource* emission_;
+    std::unique_ptr<EmissionSource::Accessor> emissionAccessor_;  ///< null without emission
     std::vector<Bin> bins_;
     std::unique_ptr<ActiveRegions> ownRegions_;
     const ActiveRegions* regions_;
@@ -94,8 +98,9 @@ private:
 /// kPrefilterCutoffSigmas standard deviations of its centre.
 /// @param control progress (fraction of sample rows traced) and stop (polled per sample row).
 /// @throw RenderStopped when control.stop returned true.
+/// @param emission each voxel's emission (nullptr: none), as RayIntegrator.
 Image renderReference(const Volume& volume, const ClassificationTable& table, const Camera& camera, int spp,
                       RenderStats& stats, const ShadingField* shading = nullptr,
-                      const RenderControl& control = {});
+                      const RenderControl& control = {}, const EmissionSource* emission = nullptr);
 
 }  // namespace vdbsplat

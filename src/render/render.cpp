@@ -70,6 +70,9 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     std::unique_ptr<VoxelShader> shader;
     if (settings.shading.active())
         shader = std::make_unique<VoxelShader>(volume, table, lo, hi, camera.eye(), settings.shading);
+    // Emission (docs/emission.md): the attached grid's ε, added to every voxel after shading.
+    std::unique_ptr<EmissionSource> emission;
+    if (settings.emission.active()) emission = makeEmissionSource(volume, settings.emission);
     Image image;
     switch (settings.mode) {
         case RenderMode::Reference: {
@@ -78,7 +81,7 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
                 field = std::make_unique<ShadingField>(*shader);
                 stats.shadingSeconds = field->seconds();
             }
-            image = renderReference(volume, table, camera, settings.spp, stats, field.get(), control);
+            image = renderReference(volume, table, camera, settings.spp, stats, field.get(), control, emission.get());
             break;
         }
         case RenderMode::Hybrid:
@@ -86,7 +89,7 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
         case RenderMode::Point: {
             const Tables tables =
                 loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir));
-            image = renderForward(volume, table, camera, tables, settings, stats, shader.get(), control);
+            image = renderForward(volume, table, camera, tables, settings, stats, shader.get(), control, emission.get());
             break;
         }
     }

@@ -43,6 +43,7 @@ void RenderSettings::validate() const {
     if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
         throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
     shading.validate();
+    emission.validate();
     if (!tablesDir.empty()) {
         std::error_code ec;
         if (!std::filesystem::is_directory(tablesDir, ec))
@@ -104,6 +105,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["simd"] = simd;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
     if (shading.active()) j["shading"] = shading.toJson();  // absent when off: unshaded outputs unchanged
+    if (emission.active()) j["emission"] = emission.toJson();  // likewise
     return j;
 }
 

@@ -10,6 +10,7 @@
 #include "camera/camera.h"
 #include "util/error.h"
 #include "shading/shading.h"
+#include "volume/emission.h"
 #include "volume/stream.h"
 
 namespace vdbsplat {
@@ -88,6 +89,7 @@ struct RenderSettings {
     StreamOptions stream;                   ///< how the grid is streamed: speed and memory, never the image
     uint64_t maxActiveVoxels = kDefaultMaxActiveVoxels;  ///< larger grids are refused before any work
     ShadingSettings shading;                ///< off by default: the unshaded emission–absorption image
+    EmissionSettings emission;              ///< --emission GRID and its colour map (docs/emission.md); off by default
 
     /// @throw Error naming the flag of the first invalid value (--tables: DIR must be a directory).
     void validate() const;

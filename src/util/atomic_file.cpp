@@ -150,4 +150,12 @@ void writeTextFileAtomic(const std::string& path, const std::string& text) {
     renameIntoPlace(tmp, target, path);
 }
 
+void checkNotAnInput(const std::string& output, const std::string& input, const std::string& flag) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const bool same = fs::exists(output, ec) && fs::exists(input, ec) ? fs::equivalent(output, input, ec)
+                                                                       : fs::weakly_canonical(output, ec) == fs::weakly_canonical(input, ec);
+    if (same && !ec) throw Error(flag + ": " + output + ": is the input file " + input + " (it would be overwritten)");
+}
+
 }  // namespace vdbsplat

@@ -35,6 +35,11 @@ OutputKind checkOutputPath(const std::string& path);
 /// that need a seekable regular file. @p flag (e.g. "-o") prefixes the message when given.
 void checkRegularOutputPath(const std::string& path, const std::string& flag = "");
 
+/// @brief Refuses an output that would replace one of the command's inputs: the same file
+/// through any path, symbolic link or hard link (render --stats IN.vdb, bench --json IN.vdb).
+/// @throw Error "<flag>: <output>: is the input file <input>" when they are the same file.
+void checkNotAnInput(const std::string& output, const std::string& input, const std::string& flag);
+
 /// @brief A temporary name beside @p target (same folder, so rename is atomic), ending in
 /// @p suffix (the image writers keep the extension last).
 std::string temporaryPathFor(const std::string& target, const std::string& suffix = "");

@@ -61,11 +61,16 @@ struct HugePageAllocator {
         if (bytes < huge_pages::kHugePage) ::operator delete(p, std::align_val_t(alignof(T) > 16 ? alignof(T) : 16));
         else munmap(p, huge_pages::roundUp(bytes));
     }
-    /// Default-initialises (trivial types: leaves them as they are): the renderer's buffers are
-    /// written before they are read, and vector::resize would otherwise zero them, serially.
+    /// Default construction leaves trivially copyable, trivially destructible elements as they
+    /// are, even where the type has default member initialisers (Primitive, ExactIndexMap): such
+    /// a type is an implicit-lifetime type (C++20, P0593), so the mapped memory already holds its
+    /// objects, and the renderer's window buffers are written before they are read. Otherwise
+    /// vector::resize would write every element (and take every page fault) serially on the
+    /// calling thread; now the first writes, in the parallel passes, fault the pages in.
     template <class U>
     void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
-        ::new (static_cast<void*>(p)) U;
+        if constexpr (!(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>))
+            ::new (static_cast<void*>(p)) U;
     }
     template <class U, class... Args>
     void construct(U* p, Args&&... args) {

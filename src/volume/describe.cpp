@@ -6,6 +6,7 @@
 // taken from the file is escaped (printable) before it reaches the terminal.
 #include <openvdb/io/File.h>
 
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -108,6 +109,38 @@ std::string valueRange(const openvdb::GridBase& base) {
     return s.str();
 }
 
+bool isScalar(const openvdb::GridBase& g) { return g.valueType() == "float" || g.valueType() == "double"; }
+
+/// Names that VFX tools give the grids that drive emission (Houdini, EmberGen, Blender).
+bool soundsEmissive(std::string name) {
+    for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+    for (const char* word : {"temperature", "temp", "flame", "fire", "heat", "emission", "fuel"})
+        if (name.find(word) != std::string::npos) return true;
+    return false;
+}
+
+/// What grid @p i of @p grids can be used for: density (--grid), emission (--emission, with
+/// every density grid of the same transform), or nothing and why.
+std::string usage(const openvdb::GridPtrVec& grids, size_t i) {
+    const openvdb::GridBase& g = *grids[i];
+    if (!isScalar(g)) return "not renderable (" + printable(g.valueType()) + " values; vdbsplat renders float and double grids)";
+    if (g.activeVoxelCount() == 0) return "not renderable (no active voxels)";
+    const std::string problem = transformProblem(g.transform());
+    if (!problem.empty()) return "not renderable (" + printable(problem) + ")";
+    size_t firstScalar = grids.size();
+    for (size_t k = 0; k < grids.size() && firstScalar == grids.size(); ++k)
+        if (isScalar(*grids[k])) firstScalar = k;
+    std::string out = "density (--grid " + printable(g.getName()) + (i == firstScalar ? ", the default)" : ")");
+    std::string partners;
+    for (size_t k = 0; k < grids.size(); ++k)
+        if (k != i && isScalar(*grids[k]) && grids[k]->transform() == g.transform() && grids[k]->activeVoxelCount() > 0)
+            partners += std::string(partners.empty() ? "" : ", ") + "'" + printable(grids[k]->getName()) + "'";
+    if (!partners.empty())
+        out += "; emission (--emission " + printable(g.getName()) + ") with density grid " + partners +
+               (soundsEmissive(g.getName()) ? " (its name suggests emission)" : "");
+    return out;
+}
+
 std::string describeGrid(const openvdb::GridBase& grid, size_t index) {
     std::ostringstream s;
     const auto& xform = grid.transform();
@@ -157,7 +190,8 @@ std::string describeFile(const std::string& path) {
     s << printable(path) << ": VDB file version " << printable(version) << ", " << grids->size() << " grid" << (grids->size() == 1 ? "" : "s")
       << "\n";
     try {
-        for (size_t i = 0; i < grids->size(); ++i) s << describeGrid(*(*grids)[i], i);
+        for (size_t i = 0; i < grids->size(); ++i)
+            s << describeGrid(*(*grids)[i], i) << "  use:           " << usage(*grids, i) << "\n";
     } catch (const std::exception& e) {  // OpenVDB's own exceptions from a grid it read
         throw Error(path + ": corrupt VDB file (" + std::string(e.what()) + ")");
     }

@@ -3,7 +3,8 @@
 // Checker Box, Marschner & Lobb 1994's test signal (their eq. 1 with f_M = 6, α = 0.25),
 // a smooth fog ball, and a hash-based fractal value-noise cloud whose threshold is
 // chosen from a histogram so that the active count is close to the request, and random thin
-// tubes and sheets (capsules along quadratic Bézier axes, discs), seeded.
+// tubes and sheets (capsules along quadratic Bézier axes, discs), seeded, and an explosion
+// (density + temperature: noisy lobes with a hot core), seeded.
 #include "volume/generate.h"
 
 #include <tbb/blocked_range.h>
@@ -416,23 +417,107 @@ std::unique_ptr<LeafT> buildTubeLeaf(const std::vector<TubePiece>& pieces, const
     });
 }
 
+// ---------------------------------------------------------------------------
+// Explosion: a fireball of random lobes (soft union of balls) roughened by fractal value
+// noise; temperature is a hotter, noisier core inside the smoke. Counter-based random
+// numbers as the tubes (one draw per statement), so every compiler makes the same layout.
+// ---------------------------------------------------------------------------
+
+constexpr int kExplosionLobes = 9;
+constexpr double kExplosionRadius = 0.36;      ///< main ball radius (× (res − 1))
+constexpr double kExplosionNoise = 0.45;       ///< fBm amplitude added to the lobe field
+constexpr double kExplosionEdge = 0.30;        ///< field width over which density rises 0 → 1
+constexpr double kExplosionCoreStart = 0.30;   ///< lobe field where the temperature starts
+constexpr double kExplosionCoreWidth = 0.55;   ///< ... and the width over which it reaches 1
+
+struct ExplosionLobe {
+    openvdb::Vec3d centre;
+    double radius;
+};
+
+std::vector<ExplosionLobe> explosionLayout(int res, uint64_t seed) {
+    uint64_t draw = 0;
+    const auto u = [&](uint64_t stream) { return uniform01(seed, stream, draw++); };
+    const double c = 0.5 * (res - 1), R = kExplosionRadius * (res - 1);
+    std::vector<ExplosionLobe> lobes{{openvdb::Vec3d(c, c, c - 0.1 * R), 0.75 * R}};
+    for (int i = 0; i < kExplosionLobes; ++i) {
+        // A direction biased upwards (+z: the fireball rises), one draw per statement.
+        const double z = 1.2 * u(7) - 0.4;
+        const double phi = 2.0 * std::numbers::pi * u(7);
+        const double reach = 0.25 + 0.4 * u(8);
+        const double size = 0.3 + 0.25 * u(9);
+        const double rxy = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const openvdb::Vec3d dir(rxy * std::cos(phi), rxy * std::sin(phi), z);
+        lobes.push_back({openvdb::Vec3d(c, c, c) + reach * R * dir, size * R});
+    }
+    return lobes;
+}
+
+/// The soft union of the lobes: max_i (1 − |x − c_i| / r_i) (1 at a centre, 0 on its sphere).
+double lobeField(const std::vector<ExplosionLobe>& lobes, const openvdb::Vec3d& x) {
+    double best = -1e9;
+    for (const ExplosionLobe& l : lobes) best = std::max(best, 1.0 - (x - l.centre).length() / l.radius);
+    return best;
+}
+
+/// Fractal value noise in [−1, 1) (4 octaves of the cloud's lattice noise, normalised).
+double explosionNoise(const CloudField& field, const Coord& xyz) {
+    double sum = 0.0, amplitude = 1.0, norm = 0.0, frequency = 6.0;
+    for (int o = 0; o < 4; ++o, amplitude *= 0.5, frequency *= 2.0) {
+        sum += amplitude * field.noiseAt(xyz, o, frequency);
+        norm += amplitude;
+    }
+    return sum / norm;
+}
+
+}  // namespace
+
+std::vector<openvdb::FloatGrid::Ptr> makeExplosion(int res, uint64_t seed) {
+    const std::vector<ExplosionLobe> lobes = explosionLayout(res, seed);
+    const CloudField smoke{mix64(seed ^ 0x5A0E), res}, heat{mix64(seed ^ 0x4EA7), res};
+    const auto densityAt = [&](const Coord& c) {
+        const double f = lobeField(lobes, openvdb::Vec3d(c.x(), c.y(), c.z())) + kExplosionNoise * explosionNoise(smoke, c);
+        return std::clamp(f / kExplosionEdge, 0.0, 1.0);
+    };
+    const auto temperatureAt = [&](const Coord& c) {
+        const double f = lobeField(lobes, openvdb::Vec3d(c.x(), c.y(), c.z())) + 0.6 * explosionNoise(heat, c);
+        return std::clamp((f - kExplosionCoreStart) / kExplosionCoreWidth, 0.0, 1.0);
+    };
+    char label[96];
+    std::snprintf(label, sizeof label, "explosion res=%d seed=%llu", res, (unsigned long long)seed);
+    auto density = buildGrid(cube(res), label, [&](const Coord& c, float& v) {
+        v = float(densityAt(c));
+        return v > 0.f;
+    });
+    auto temperature = buildGrid(cube(res), label, [&](const Coord& c, float& v) {
+        v = float(temperatureAt(c));
+        return v > 0.f && densityAt(c) > 0.0;  // inside the smoke
+    });
+    temperature->setName("temperature");
+    temperature->setGridClass(openvdb::GRID_UNKNOWN);
+    return {density, temperature};
+}
+
+namespace {
 }  // namespace
 
 // ---------------------------------------------------------------------------
 
 const std::vector<std::string>& generatorKinds() {
-    static const std::vector<std::string> kinds{"checkerbox", "marschner-lobb", "sphere", "cloud", "tubes"};
+    static const std::vector<std::string> kinds{"checkerbox", "marschner-lobb", "sphere", "cloud", "tubes", "explosion"};
     return kinds;
 }
 
 void GenerateOptions::validate() {
     const auto& kinds = generatorKinds();
     if (std::find(kinds.begin(), kinds.end(), kind) == kinds.end())
-        throw Error("generate: unknown kind '" + kind + "' (choose checkerbox, marschner-lobb, sphere, cloud or tubes)");
-    const bool cloud = kind == "cloud", tubes = kind == "tubes";
+        throw Error("generate: unknown kind '" + kind +
+                    "' (choose checkerbox, marschner-lobb, sphere, cloud, tubes or explosion)");
+    const bool cloud = kind == "cloud", tubes = kind == "tubes", explosion = kind == "explosion";
     if (cloud && res) throw Error("--res: not used by 'cloud' (its size follows --active)");
     if (!cloud && active) throw Error("--active: only 'cloud' takes an active voxel count");
-    if (!cloud && !tubes && seed) throw Error("--seed: only 'cloud' and 'tubes' are random");
+    if (!cloud && !tubes && !explosion && seed) throw Error("--seed: only 'cloud', 'tubes' and 'explosion' are random");
+    if (explosion && !seed) seed = kDefaultCloudSeed;
     if (!tubes && count) throw Error("--count: only 'tubes' takes a tube count");
     if (!tubes && sheets) throw Error("--sheets: only 'tubes' takes a sheet count");
     if (!tubes && (radiusMin || radiusMax)) throw Error("--radius-min/--radius-max: only 'tubes' takes a radius");
@@ -449,8 +534,9 @@ void GenerateOptions::validate() {
         res = kind == "checkerbox" ? kDefaultCheckerRes
               : kind == "sphere"   ? kDefaultSphereRes
               : tubes              ? kDefaultTubesRes
+              : explosion          ? kDefaultExplosionRes
                                    : kDefaultMarschnerLobbRes;
-    const int minRes = kind == "sphere" ? 3 : 2;
+    const int minRes = kind == "sphere" ? 3 : explosion ? 8 : 2;
     if (*res < minRes || *res > kMaxGenerateRes)
         throw Error("--res: " + std::to_string(*res) + " is outside [" + std::to_string(minRes) + ", " +
                     std::to_string(kMaxGenerateRes) + "]");
@@ -461,8 +547,15 @@ void GenerateOptions::validate() {
                     " active voxels, more than the limit of " + std::to_string(kMaxGeneratedVoxels));
 }
 
+std::vector<openvdb::FloatGrid::Ptr> generateGrids(GenerateOptions options) {
+    options.validate();
+    if (options.kind == "explosion") return makeExplosion(*options.res, *options.seed);
+    return {generateVolume(options)};
+}
+
 openvdb::FloatGrid::Ptr generateVolume(GenerateOptions options) {
     options.validate();
+    if (options.kind == "explosion") return makeExplosion(*options.res, *options.seed).front();
     if (options.kind == "checkerbox") return makeCheckerBox(*options.res);
     if (options.kind == "marschner-lobb") return makeMarschnerLobb(*options.res);
     if (options.kind == "sphere") return makeSphere(*options.res);

@@ -6,7 +6,8 @@
 //  - sphere:         a smooth fog ball,
 //  - cloud:          thresholded fractal value noise with a requested active count,
 //  - tubes:          random thin tubes and a few thin sheets (DESIGN §8.3: structures one or
-//                    two pixels wide, where filtering optical depth before compositing fails).
+//                    two pixels wide, where filtering optical depth before compositing fails),
+//  - explosion:      a fireball: "density" plus a "temperature" grid for emission (docs/emission.md).
 // Every grid is built leaf by leaf (8³) in parallel and inserted in a fixed order,
 // so the result is identical for any thread count and never densified.
 #pragma once
@@ -39,6 +40,8 @@ inline constexpr uint64_t kDefaultCloudActive = 1'000'000, kDefaultCloudSeed = 1
 /// Tubes: the defaults make issue 10's reference volume (14 tubes, radius 0.7–2.5 voxels).
 inline constexpr int kDefaultTubesRes = 128, kDefaultTubeCount = 14, kDefaultSheetCount = 2;
 inline constexpr double kDefaultTubeRadiusMin = 0.7, kDefaultTubeRadiusMax = 2.5;
+/// Explosion: default grid side.
+inline constexpr int kDefaultExplosionRes = 96;
 /// Tubes: density 1 within the radius, then (1 − (s/w)²)² over a rim of w voxels (C¹), 0 beyond.
 inline constexpr double kTubeFalloffVoxels = 1.0;
 /// Tubes: radius bounds accepted by --radius-min/--radius-max (voxels), and the most tubes/sheets.
@@ -66,7 +69,11 @@ private:
 /// @brief The names accepted as GenerateOptions::kind, in documentation order.
 const std::vector<std::string>& generatorKinds();
 
-/// @brief Generates the grid described by @p options (validated first).
+/// @brief Generates every grid @p options describe (validated first): one, or for 'explosion'
+/// the density and the temperature grid. @throw Error as GenerateOptions::validate.
+std::vector<openvdb::FloatGrid::Ptr> generateGrids(GenerateOptions options);
+
+/// @brief Generates the grid described by @p options (validated first; 'explosion': its density).
 /// @throw Error as GenerateOptions::validate.
 openvdb::FloatGrid::Ptr generateVolume(GenerateOptions options);
 
@@ -120,5 +127,11 @@ double tubeProfile(double d, double r);
 /// density max over primitives of tubeProfile(tubeDistance), active where > 0.
 /// Deterministic by @p seed for any thread count. Options validated by GenerateOptions.
 openvdb::FloatGrid::Ptr makeTubes(int res, int count, int sheets, double radiusMin, double radiusMax, uint64_t seed);
+
+/// @brief A fireball in the res³ box: "density" (soft union of a main ball and kExplosionLobes
+/// random lobes rising upwards, roughened by fractal value noise, values in (0, 1]) and
+/// "temperature" (a hotter, noisier core, values in (0, 1], active only where the density is).
+/// Deterministic by @p seed for any thread count and compiler.
+std::vector<openvdb::FloatGrid::Ptr> makeExplosion(int res, uint64_t seed);
 
 }  // namespace vdbsplat

@@ -67,8 +67,13 @@ openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::stri
     return base;
 }
 
-/// The index→world matrix of a linear transform with uniform scale; refuses anything else.
-glm::dmat4 linearUniformMap(const openvdb::math::Transform& transform, const std::string& label, double& voxelSize) {
+/// The index→world matrix of a linear (affine) transform: any rotation, scale per axis, shear
+/// and translation (the kernels are then ellipsoids, footprint/ellipsoid.h). @p voxelSize gets
+/// h = |det A|^(1/3), the edge of the cube of the voxel's volume: the energy rule's M = h³ is
+/// the kernel's world volume, and a transfer function's "per voxel" extinction is per h.
+/// Refuses frustum (non-linear) maps and singular or non-finite matrices.
+glm::dmat4 linearAffineMap(const openvdb::math::Transform& transform, const std::string& label, double& voxelSize,
+                           bool& isotropic) {
     if (!transform.isLinear()) throw Error(label + ": transform is not linear (frustum maps are not supported)");
     openvdb::Mat4d m;
     try {  // OpenVDB inverts the matrix as it builds the affine map: a singular one throws
@@ -81,15 +86,18 @@ glm::dmat4 linearUniformMap(const openvdb::math::Transform& transform, const std
         for (int r = 0; r < 4; ++r) map[c][r] = m(c, r);  // OpenVDB is row-vector: world = [i j k 1]·m
     const glm::dvec3 a0(map[0]), a1(map[1]), a2(map[2]);
     const double h0 = glm::length(a0), h1 = glm::length(a1), h2 = glm::length(a2);
-    if (!(h0 > 0.0) || !std::isfinite(h0 + h1 + h2)) throw Error(label + ": transform has a zero or non-finite voxel size");
+    const double det = glm::determinant(glm::dmat3(map));
+    if (!std::isfinite(h0 + h1 + h2 + det) || !std::isfinite(map[3].x + map[3].y + map[3].z))
+        throw Error(label + ": transform has a non-finite entry");
+    if (!(h0 > 0.0 && h1 > 0.0 && h2 > 0.0)) throw Error(label + ": transform has a zero voxel size");
+    // |det| against the product of the column lengths: 1 for orthogonal axes, 0 for a flat map.
+    if (!(std::abs(det) > 1e-9 * h0 * h1 * h2))
+        throw Error(label + ": transform is singular (its voxel axes are linearly dependent)");
+    voxelSize = std::cbrt(std::abs(det));
     const double tol = 1e-6 * h0;
-    if (std::abs(h1 - h0) > tol || std::abs(h2 - h0) > tol)
-        throw Error(label + ": non-uniform voxel size (" + std::to_string(h0) + ", " + std::to_string(h1) + ", " +
-                    std::to_string(h2) + ") is not supported");
-    if (std::abs(glm::dot(a0, a1)) > tol * h0 || std::abs(glm::dot(a0, a2)) > tol * h0 ||
-        std::abs(glm::dot(a1, a2)) > tol * h0)
-        throw Error(label + ": transform has shear, which is not supported");
-    voxelSize = h0;
+    isotropic = std::abs(h1 - h0) <= tol && std::abs(h2 - h0) <= tol && std::abs(glm::dot(a0, a1)) <= tol * h0 &&
+                std::abs(glm::dot(a0, a2)) <= tol * h0 && std::abs(glm::dot(a1, a2)) <= tol * h0;
+    if (isotropic) voxelSize = h0;  // a rotation of cubes: exactly the column length, as before
     return map;
 }
 
@@ -114,6 +122,18 @@ void sanitizeValues(Volume& v) {
 }
 
 }  // namespace
+
+std::string transformProblem(const openvdb::math::Transform& transform) {
+    try {
+        double voxelSize = 0.0;
+        bool isotropic = true;
+        linearAffineMap(transform, "transform", voxelSize, isotropic);
+        return "";
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        return what.rfind("transform: ", 0) == 0 ? what.substr(11) : what;
+    }
+}
 
 void initOpenVdb() {
     static std::once_flag once;
@@ -152,7 +172,7 @@ Volume wrapGrid(openvdb::FloatGrid::Ptr grid, const std::string& label, uint64_t
     v.grid = std::move(grid);
     v.name = v.grid->getName();
     const std::string where = gridLabel(label, v.name);
-    v.indexToWorld = linearUniformMap(v.grid->transform(), where, v.voxelSize);
+    v.indexToWorld = linearAffineMap(v.grid->transform(), where, v.voxelSize, v.isotropic);
     v.worldToIndex = glm::inverse(v.indexToWorld);
     v.activeVoxels = activeVoxels;
     if (v.activeVoxels == 0) throw Error(where + ": grid has no active voxels");
@@ -205,7 +225,8 @@ Volume loadVolume(const std::string& path, const std::string& gridName) {
         OpenVdbLogCapture log;
         const openvdb::GridBase::Ptr base = readGridToRender(path, gridName, hint);
         double voxelSize = 0.0;  // refuse what the parent would refuse, before handing it over
-        linearUniformMap(base->transform(), gridLabel(path, base->getName()), voxelSize);
+        bool isotropic = true;
+        linearAffineMap(base->transform(), gridLabel(path, base->getName()), voxelSize, isotropic);
         try {
             encodeGridTransfer(*base, log.held(), transfer.fd(), path);
         } catch (const Error& e) {  // the read worked; only the hand-over did not (e.g. ulimit -f)
@@ -236,14 +257,17 @@ Volume loadVolume(const std::string& path, const std::string& gridName) {
     return v;
 }
 
-void writeVolume(const std::string& path, openvdb::FloatGrid::Ptr grid) {
+void writeVolume(const std::string& path, openvdb::FloatGrid::Ptr grid) { writeVolumes(path, {std::move(grid)}); }
+
+void writeVolumes(const std::string& path, const std::vector<openvdb::FloatGrid::Ptr>& grids) {
     initOpenVdb();
     checkRegularOutputPath(path);
     const std::string target = resolveOutputPath(path);  // through a symbolic link, never replacing it
     const std::string tmp = temporaryPathFor(target);
     try {
         openvdb::io::File file(tmp);
-        file.write({grid});
+        openvdb::GridCPtrVec all(grids.begin(), grids.end());
+        file.write(all);
         file.close();
     } catch (const std::exception& e) {
         std::remove(tmp.c_str());

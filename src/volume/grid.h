@@ -7,23 +7,33 @@
 #include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace vdbsplat {
+
+struct EmissionGrid;  // volume/emission.h
 
 /// @brief One scalar grid ready to render.
 struct Volume {
     openvdb::FloatGrid::Ptr grid;   ///< values as float; non-finite values were set to 0 (see nonFiniteCount)
     std::string file;               ///< the file it came from ("" if generated in memory)
     std::string name;               ///< the grid's name
-    double voxelSize = 1.0;         ///< h, world units per voxel (uniform; non-uniform scale is refused)
+    /// h, world units per voxel: |det A|^(1/3) for the linear part A of indexToWorld (the edge
+    /// of the cube with the voxel's volume; the column length for cubic voxels).
+    double voxelSize = 1.0;
+    /// A is h·(rotation): cubic voxels, sphere kernels. False: anisotropic or sheared voxels,
+    /// ellipsoid kernels (footprint/ellipsoid.h).
+    bool isotropic = true;
     glm::dmat4 indexToWorld{1.0};   ///< affine map from index space (voxel centres at integers) to world
     glm::dmat4 worldToIndex{1.0};   ///< its inverse
     openvdb::CoordBBox indexBox;    ///< bounding box of the active voxels (inclusive)
     uint64_t activeVoxels = 0;      ///< active voxel count (active tiles counted as their voxels)
     uint64_t nonFiniteCount = 0;    ///< active voxels whose NaN/inf value was replaced by 0
     float valueMin = 0.f, valueMax = 1.f;  ///< range of finite active values
+    /// An emission grid sharing this grid's kernels (volume/emission.h: attachEmission); null: none.
+    std::shared_ptr<const EmissionGrid> emission;
 
     /// @brief World-space bounds of the active voxels' centres, widened by half a voxel.
     void worldBounds(glm::dvec3& lo, glm::dvec3& hi) const;
@@ -35,11 +45,15 @@ void initOpenVdb();
 /// @brief Loads grid @p gridName (or, if empty, the first float/double scalar grid) from @p path.
 /// @throw Error naming the file and the problem: missing, not a VDB, truncated or corrupt,
 /// no float grid, no grid of that name, an empty grid, or a transform that is not linear
-/// with uniform scale.
+/// (frustum) or is singular. Any affine map is accepted (anisotropic voxels, rotation, shear).
 Volume loadVolume(const std::string& path, const std::string& gridName = "");
 
 /// @brief Wraps an in-memory float grid (tests, generators) as a Volume, validating it as loadVolume does.
 Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label = "<memory>");
+
+/// @brief Empty when vdbsplat can render a grid with transform @p transform, else the reason
+/// (the check loadVolume applies; `vdbsplat info` reports it).
+std::string transformProblem(const openvdb::math::Transform& transform);
 
 /// @brief A human-readable description of every grid in @p path (`vdbsplat info`).
 /// @throw Error as loadVolume for unreadable files.
@@ -48,5 +62,8 @@ std::string describeFile(const std::string& path);
 /// @brief Writes @p grid to @p path atomically (temporary file, then rename).
 /// @throw Error naming the path on failure.
 void writeVolume(const std::string& path, openvdb::FloatGrid::Ptr grid);
+
+/// @brief Writes several grids (e.g. density and temperature) to one file, as writeVolume.
+void writeVolumes(const std::string& path, const std::vector<openvdb::FloatGrid::Ptr>& grids);
 
 }  // namespace vdbsplat

@@ -2,7 +2,7 @@
 // Owns: building an OpenVDB linear transform from three axis vectors and an origin, and the
 // checks every header's geometry must pass (finite, voxel sizes in convert's accepted range,
 // origin bounded, axes not singular). Non-uniform and rotated axes are kept: converting is
-// allowed; `render` accepts rotations with cubic voxels and refuses non-uniform voxel sizes.
+// allowed, and `render` takes any of them (anisotropic voxels: ellipsoid kernels, docs/kernel.md).
 #pragma once
 #include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 

@@ -251,7 +251,7 @@ std::array<int, 3> parseDims(std::string_view text, const std::string& flag) {
     return dims;
 }
 
-double parseUniformSpacing(std::string_view text, const std::string& flag) {
+std::array<double, 3> parseSpacing(std::string_view text, const std::string& flag) {
     const std::vector<double> s = parseDoubleList(text, flag, 3);
     for (double v : s)
         if (!(v > 0.0)) throw Error(flag + ": spacing must be positive, got '" + std::string(text) + "'");
@@ -259,11 +259,13 @@ double parseUniformSpacing(std::string_view text, const std::string& flag) {
         if (v < kMinRawSpacing || v > kMaxRawSpacing)
             throw Error(flag + ": spacing '" + std::string(text) + "' is outside [1e-4, 1e6] world units per voxel " +
                         "(pick units that bring it into range, e.g. mm instead of m)");
-    const double tol = 1e-6 * s[0];
-    if (std::abs(s[1] - s[0]) > tol || std::abs(s[2] - s[0]) > tol)
-        throw Error(flag + ": non-uniform spacing '" + std::string(text) +
-                    "' is not supported (the renderer needs cubic voxels; resample the volume first)");
-    return s[0];
+    return {s[0], s[1], s[2]};
+}
+
+openvdb::math::Transform::Ptr spacingTransform(const std::array<double, 3>& s) {
+    if (s[0] == s[1] && s[0] == s[2]) return openvdb::math::Transform::createLinearTransform(s[0]);
+    return openvdb::math::Transform::createLinearTransform(
+        openvdb::Mat4d(s[0], 0.0, 0.0, 0.0, 0.0, s[1], 0.0, 0.0, 0.0, 0.0, s[2], 0.0, 0.0, 0.0, 0.0, 1.0));
 }
 
 uint64_t voxelCount(const std::array<int, 3>& dims) {
@@ -352,7 +354,7 @@ openvdb::FloatGrid::Ptr convertRaw(const std::string& path, const RawSpec& spec,
     VoxelSource source;
     source.path = path;
     const VoxelLayout layout{spec.dims, spec.type, false};
-    return readVoxels(source, layout, spec.threshold, openvdb::math::Transform::createLinearTransform(spec.spacing),
+    return readVoxels(source, layout, spec.threshold, spacingTransform(spec.spacing),
                       statsOut);
 }
 

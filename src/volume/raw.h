@@ -33,7 +33,7 @@ inline constexpr double kMaxRawSpacing = 1e6;
 struct RawSpec {
     std::array<int, 3> dims{0, 0, 0};  ///< X, Y, Z voxel counts, each in [1, kMaxRawDim]
     RawType type = RawType::UInt8;
-    double spacing = 1.0;              ///< uniform voxel size (world units)
+    std::array<double, 3> spacing{1.0, 1.0, 1.0};  ///< voxel size along x, y, z (world units)
     double threshold = 0.0;            ///< active iff normalised value > threshold
     uint64_t maxVoxels = kDefaultMaxRawVoxels;  ///< X*Y*Z above this is refused before reading
 };
@@ -65,9 +65,14 @@ RawType parseRawType(std::string_view text, const std::string& flag);
 /// @brief "X,Y,Z" → three integers in [1, kMaxRawDim]. @throw Error naming @p flag otherwise.
 std::array<int, 3> parseDims(std::string_view text, const std::string& flag);
 
-/// @brief "SX,SY,SZ" → the common voxel size. @throw Error naming @p flag when a value is not
-/// positive, finite and in [kMinRawSpacing, kMaxRawSpacing], or when the spacing is non-uniform (the renderer needs cubic voxels).
-double parseUniformSpacing(std::string_view text, const std::string& flag);
+/// @brief "SX,SY,SZ" → the voxel size along x, y and z (any three, e.g. 1,1,2.5 for thick
+/// slices: the renderer takes anisotropic voxels, docs/kernel.md). @throw Error naming @p flag
+/// when a value is not positive, finite and in [kMinRawSpacing, kMaxRawSpacing].
+std::array<double, 3> parseSpacing(std::string_view text, const std::string& flag);
+
+/// @brief The linear transform of voxel size @p spacing, index (0,0,0) at the world origin: a
+/// uniform scale map when the three are equal, else a scale map with one size per axis.
+openvdb::math::Transform::Ptr spacingTransform(const std::array<double, 3>& spacing);
 
 /// @brief How the voxels of a volume are laid out, whatever the file format around them.
 struct VoxelLayout {
@@ -132,7 +137,7 @@ openvdb::FloatGrid::Ptr readVoxels(const VoxelSource& source, const VoxelLayout&
                                    openvdb::math::Transform::Ptr transform, RawStats* stats = nullptr);
 
 /// @brief Reads @p path (raw or gzip-compressed raw) as described by @p spec into a fog-volume
-/// float grid named "density" with voxel size spec.spacing, index (0,0,0) at the world origin.
+/// float grid named "density" with voxel size spec.spacing (spacingTransform), index (0,0,0) at the world origin.
 /// @param stats if not null, receives what was read
 /// @throw Error "--dims: …" when X*Y*Z exceeds spec.maxVoxels (before reading); naming the file:
 /// missing or unreadable, corrupt gzip data, trailing garbage after it, or a size that does not

@@ -27,7 +27,8 @@
 
 namespace vdbsplat {
 
-class VoxelShader;  // shading/shading_field.h
+class VoxelShader;     // shading/shading_field.h
+class EmissionSource;  // volume/emission.h
 
 /// @brief One depth window of voxels, structure of arrays, in a deterministic order.
 struct VoxelBatch {
@@ -73,6 +74,9 @@ struct StreamOptions {
     /// Voxels whose projected spacing h·f/z is under this many pixels are drawn as points by
     /// the renderer (hybrid: its threshold τ; point mode: +∞; splat mode: 0, no aggregates).
     double pointBelowPx = 0.0;
+    /// Whole-leaf aggregates (8³ cells) through the vectorised sums (volume/leaf_moments.h);
+    /// false: the scalar row sums they are tested against (same moments to float rounding).
+    bool vectorLeafMoments = true;
 };
 
 /// @brief Counts of what the stream released and what it culled, by cause.
@@ -88,8 +92,10 @@ public:
     /// @brief Streams @p volume for @p camera; @p table classifies values.
     /// @throw Error when the grid is too large to stream (more than 2^32 active voxels).
     /// @p shader: shades each voxel after classification (nullptr: unshaded; docs/shading.md).
+    /// @p emission: adds each voxel's emission after shading (nullptr: none; docs/emission.md).
     VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
-                const StreamOptions& options = {}, const VoxelShader* shader = nullptr);
+                const StreamOptions& options = {}, const VoxelShader* shader = nullptr,
+                const EmissionSource* emission = nullptr);
 
     /// @brief Fills @p batch with the next window front to back; false when the stream is done.
     /// @param hidden optional: returns true for a block whose screen rectangle (pixels,
@@ -122,21 +128,29 @@ private:
     void extractAggregates(const Block& b, VoxelBatch& out) const;
     template <typename Fn> void forEachActive(const Block& b, Fn&& fn) const;
     void adaptWindow(size_t released);  // the next window's slab count from this one's size
+    void release(size_t blocks, float limit, VoxelBatch& batch);  // pending + extracted → batch, pending
 
     const Volume& volume_;
     const Camera& camera_;
     const ClassificationTable& table_;
     StreamOptions options_;
     const VoxelShader* shader_;
+    const EmissionSource* emission_;
     double slabLength_;
     std::vector<Block> blocks_;   // sorted by dMin
     size_t nextBlock_ = 0;
     VoxelBatch pending_;          // voxels of activated blocks not yet released
+    VoxelBatch pendingNext_;      // the pending voxels a window keeps (swapped with pending_)
     std::vector<VoxelBatch> extracted_;  // per activated block of the window (reused)
     std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
     int64_t nextSlab_ = 0;
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
     glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)
+    // The voxel's shape in world units (volume/grid.h: any affine map): the largest semi-axis
+    // per index unit (the kernel's bounding sphere is R·this) and the half-diagonal of a block's
+    // voxel centres (bounds the block's distance range). For cubic voxels h and 3.5√3·h.
+    double largestAxis_ = 1.0;
+    double blockHalfDiagonal_ = 0.0;
     StreamCounts counts_;
     uint64_t windows_ = 0;
     size_t largest_ = 0;

@@ -55,6 +55,11 @@ public:
     bool empty() const;
     /// @brief The continuous table index a raw value maps to (unclamped; for tests).
     float indexOf(float value) const { return value * scale_ + offset_; }
+    /// @brief The kSize entries (nullptr when empty) and the index map value·scale + offset:
+    /// for vectorised classification that must agree with operator() (volume/leaf_moments.h).
+    const Classified* entries() const { return entries_.empty() ? nullptr : entries_.data(); }
+    float scale() const { return scale_; }
+    float offset() const { return offset_; }
 
 private:
     std::vector<Classified> entries_;

@@ -319,3 +319,31 @@ TEST_F(CliHostile, WriteFailureNamesTheOutputNotTheTemporary) {
 
 }  // namespace
 }  // namespace vdbsplat
+
+namespace vdbsplat {
+namespace {
+
+// An output flag naming the command's own input replaced it: `render IN.vdb --stats IN.vdb`
+// and `bench IN.vdb --json IN.vdb` overwrote the volume with JSON. Every output is now checked
+// against the inputs (same file through any path or link) before any work.
+TEST_F(CliHostile, OutputsNeverReplaceTheInput) {
+    const std::string in = sphere("s.vdb");
+    const std::string before = slurp(in);
+    fs::create_hard_link(in, path("hard.vdb"));
+    expectError(run("render '" + in + "' -o " + q("o.png") + " --stats '" + in + "'"), "--stats");
+    expectError(run("render '" + in + "' -o " + q("o.png") + " --stats " + q("hard.vdb")), "is the input file");
+    EXPECT_FALSE(fs::exists(path("o.png")));
+    expectError(run("bench '" + in + "' --runs 1 --warmup 0 --distances 8 --modes point --json '" + in + "'"), "--json");
+    Image img(8, 8);
+    writeImage(path("a.png"), img);
+    const std::string image = slurp(path("a.png"));
+    expectError(run("compare " + q("a.png") + " " + q("a.png") + " --json " + q("a.png")), "--json");
+    EXPECT_EQ(slurp(path("a.png")), image);
+    spit(path("raw.bin"), std::string(8, '\x01'));
+    expectError(run("convert " + q("raw.bin") + " -o " + q("raw.bin") + " --dims 2,2,2 --type uint8"), "-o");
+    EXPECT_EQ(slurp(path("raw.bin")), std::string(8, '\x01'));
+    EXPECT_EQ(slurp(in), before);
+}
+
+}  // namespace
+}  // namespace vdbsplat

@@ -311,6 +311,48 @@ TEST_F(CliRender, BadShadingFlags) {
     });
 }
 
+// --emission (docs/emission.md): a missing grid, a non-scalar grid, a grid of another voxel size
+// or offset, bad map values, and map flags without --emission; then a good emission render.
+TEST_F(CliRender, BadEmissionGridsAndFlags) {
+    const std::string e = vdb("emission.vdb");
+    if (!fs::exists(e)) {
+        GenerateOptions sphere;
+        sphere.kind = "sphere";
+        sphere.res = 16;
+        auto density = generateVolume(sphere);
+        auto hot = density->deepCopy();
+        hot->setName("temperature");
+        auto coarse = density->deepCopy();
+        coarse->setName("coarse");
+        coarse->setTransform(openvdb::math::Transform::createLinearTransform(2.0));
+        auto shifted = density->deepCopy();
+        shifted->setName("shifted");
+        shifted->transform().postTranslate(openvdb::Vec3d(0.0, 0.0, 0.5));
+        auto vel = openvdb::Vec3SGrid::create();
+        vel->setName("vel");
+        vel->tree().setValueOn(openvdb::Coord(0), openvdb::Vec3s(1, 0, 0));
+        openvdb::io::File(e).write({density, hot, coarse, shifted, vel});
+    }
+    expectAllFail({
+        {e, {"--grid", "density", "--emission", "nosuch"}, e + ": no grid named 'nosuch'"},
+        {e, {"--grid", "density", "--emission", "vel"}, e + ": grid 'vel' holds vec3s values"},
+        {e, {"--grid", "density", "--emission", "coarse"}, e + ": emission grid 'coarse' has another transform than density grid 'density'"},
+        {e, {"--grid", "density", "--emission", "shifted"}, e + ": emission grid 'shifted' has another transform"},
+        {e, {"--grid", "density", "--emission", "density"}, e + ": --emission grid 'density' is the density grid"},
+        {e, {"--grid", "density", "--emission", "temperature", "--emission-map", "nosuch"}, "--emission-map"},
+        {e, {"--grid", "density", "--emission", "temperature", "--emission-scale", "-1"}, "--emission-scale", kAllModes, kParsing},
+        {e, {"--grid", "density", "--emission", "temperature", "--kelvin", "5000,100"}, "--kelvin", kAllModes, kParsing},
+        {e, {"--grid", "density", "--emission", "temperature", "--kelvin", "5000"}, "--kelvin", kAllModes, kParsing},
+        {e, {"--grid", "density", "--emission-scale", "2"}, "--emission-scale: needs --emission GRID", kAllModes, kParsing},
+        {e, {"--grid", "density", "--emission", ""}, "--emission: expected a grid name", kAllModes, kParsing},
+    });
+    const fs::path d = runDir("emission_good");
+    const fs::path out = d / "out" / "fire.png";
+    const Result r = runBinary(renderArgs(e, out.string(), "hybrid", {"--grid", "density", "--emission", "temperature"}), d / "log");
+    EXPECT_EQ(r.rc, 0) << r.err;
+    EXPECT_TRUE(fs::exists(out));
+}
+
 TEST_F(CliRender, BadCameras) {
     const std::string s = vdb("sphere.vdb");
     expectAllFail({

@@ -441,6 +441,25 @@ TEST_F(StudyCli, OneTransferFunctionPerVolume) {
     EXPECT_FALSE(fs::exists(out("never-tfs")));
 }
 
+TEST_F(StudyCli, RenderFlagsPassThroughEmissionIncluded) {
+    // The render flags reach every render of the study: an emission grid (loaded once with its
+    // volume) makes other images than without it, and --resume tells the two apart.
+    const std::string fire = out("explosion.vdb"), dir = out("emission");
+    ASSERT_EQ(test::runVdbsplat("generate explosion --res 24 -o '" + fire + "'", local_.dir()).rc, 0);
+    const std::string args = "study '" + fire + "' -o '" + dir + "' --modes hybrid --distances 1 --size 24x24 --spp 1";
+    const CliResult plain = test::runVdbsplat(args, local_.dir());
+    ASSERT_EQ(plain.rc, 0) << plain.err;
+    const Image without = readImage(dir + "/images/explosion/gaussian/d1/hybrid.exr");
+    const CliResult lit = test::runVdbsplat(args + " --emission temperature --resume", local_.dir());
+    ASSERT_EQ(lit.rc, 0) << lit.err;
+    EXPECT_NE(lit.out.find("(2 rendered, 0 kept)"), std::string::npos) << lit.out;
+    const Image with = readImage(dir + "/images/explosion/gaussian/d1/hybrid.exr");
+    double added = 0.0;
+    for (size_t i = 0; i < with.pixels.size(); ++i) added += with.pixels[i].x - without.pixels[i].x;
+    EXPECT_GT(added, 0.0);  // emission adds light
+    test::expectOneLineError(test::runVdbsplat(args + " --emission nosuch --force", local_.dir()), "nosuch");
+}
+
 /// The value of attribute @p name of the element with id="selfcheck" in a DOM dump ("" if absent).
 std::string selfcheck(const std::string& dom, const std::string& name) {
     const size_t p = dom.find("id=\"selfcheck\"");

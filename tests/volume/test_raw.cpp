@@ -138,7 +138,7 @@ TEST_F(Raw, ThresholdIsStrictAndInNormalisedUnits) {
 
 TEST_F(Raw, SpacingSetsAUniformTransform) {
     RawSpec s = spec(4, 4, 4, RawType::UInt8);
-    s.spacing = 0.5;
+    s.spacing = {0.5, 0.5, 0.5};
     Volume v = makeVolume(convertRaw(writePlain("s.raw", Bytes(64, 200)), s));
     EXPECT_DOUBLE_EQ(v.voxelSize, 0.5);
     const glm::dvec4 w = v.indexToWorld * glm::dvec4(2, 3, 1, 1);
@@ -266,25 +266,23 @@ TEST(RawParse, DimsTypeAndSpacing) {
     EXPECT_THROW(parseRawType("int8", "--type"), Error);
     EXPECT_EQ(parseRawType("int16", "--type"), RawType::Int16);
     EXPECT_EQ(parseRawType("float64", "--type"), RawType::Float64);
-    EXPECT_EQ(parseUniformSpacing("0.5,0.5,0.5", "--spacing"), 0.5);
-    try {
-        parseUniformSpacing("1,1,1.4", "--spacing");
-        ADD_FAILURE() << "accepted non-uniform spacing";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("non-uniform"), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find("--spacing"), std::string::npos) << e.what();
-    }
-    EXPECT_THROW(parseUniformSpacing("1,1,0", "--spacing"), Error);
-    EXPECT_THROW(parseUniformSpacing("-1,-1,-1", "--spacing"), Error);
-    EXPECT_THROW(parseUniformSpacing("1,1", "--spacing"), Error);
+    EXPECT_EQ(parseSpacing("0.5,0.5,0.5", "--spacing"), (std::array<double, 3>{0.5, 0.5, 0.5}));
+    // Anisotropic voxels are accepted (the renderer draws ellipsoids) and kept per axis.
+    EXPECT_EQ(parseSpacing("1,1,2.5", "--spacing"), (std::array<double, 3>{1.0, 1.0, 2.5}));
+    const auto xform = spacingTransform({1.0, 1.0, 2.5});
+    EXPECT_NEAR(xform->voxelSize().z(), 2.5, 1e-12);
+    EXPECT_NEAR(xform->indexToWorld(openvdb::Vec3d(1, 2, 3)).z(), 7.5, 1e-12);
+    EXPECT_THROW(parseSpacing("1,1,0", "--spacing"), Error);
+    EXPECT_THROW(parseSpacing("-1,-1,-1", "--spacing"), Error);
+    EXPECT_THROW(parseSpacing("1,1", "--spacing"), Error);
     // 1e-7 gave OpenVDB's "Non-zero scale values required"; 1e300 failed later at --eye.
     for (const char* bad : {"1e-7,1e-7,1e-7", "1e300,1e300,1e300", "5e-5,5e-5,5e-5", "2e6,2e6,2e6"}) {
-        const std::string msg = errorOf([&] { parseUniformSpacing(bad, "--spacing"); });
+        const std::string msg = errorOf([&] { parseSpacing(bad, "--spacing"); });
         EXPECT_NE(msg.find("--spacing"), std::string::npos) << msg;
         EXPECT_NE(msg.find("outside"), std::string::npos) << msg;
     }
-    EXPECT_EQ(parseUniformSpacing("1e-4,1e-4,1e-4", "--spacing"), 1e-4);
-    EXPECT_EQ(parseUniformSpacing("1e6,1e6,1e6", "--spacing"), 1e6);
+    EXPECT_EQ(parseSpacing("1e-4,1e-4,1e-4", "--spacing")[0], 1e-4);
+    EXPECT_EQ(parseSpacing("1e6,1e6,1e6", "--spacing")[2], 1e6);
 }
 
 /// Converts a shared volume, or skips the test when it is absent.

@@ -198,3 +198,150 @@ TEST(Stream, WindowsNarrowWhileOverTheVoxelBound) {
 
 }  // namespace
 }  // namespace vdbsplat
+
+namespace vdbsplat {
+namespace {
+
+// Level of detail (DESIGN §8.2) against brute force: each aggregate of a cell of 2^L voxels per
+// side carries the cell's mass Σσ, σ-weighted colour, σ-weighted centroid (view space), the
+// projected second moment about it (trace/2 of J Σ Jᵀ) and its voxel count — for a partly
+// active leaf of random values and a colour-varying table, at every level.
+TEST(Stream, AggregatesMatchBruteForceMoments) {
+    initOpenVdb();
+    auto grid = openvdb::FloatGrid::create(0.f);
+    grid->setName("density");
+    uint32_t state = 12345;
+    const auto rnd = [&] { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1 << 24); };
+    for (int x = 0; x < 8; ++x)
+        for (int y = 0; y < 8; ++y)
+            for (int z = 0; z < 8; ++z) {
+                const float keep = rnd(), value = rnd();
+                if (keep < 0.6f) grid->tree().setValueOn(openvdb::Coord(16 + x, 8 + y, z), value);
+            }
+    const Volume v = makeVolume(grid, "leaf");
+    std::vector<Classified> entries(ClassificationTable::kSize);
+    for (int i = 0; i < ClassificationTable::kSize; ++i) {
+        const float t = float(i) / float(ClassificationTable::kSize - 1);
+        entries[size_t(i)] = {glm::vec3(t, 1.f - t, 0.25f + 0.5f * t * t), 0.05f + t};
+    }
+    const ClassificationTable table(entries, 0.f, 1.f);
+    const Camera camera({-300.0, -200.0, 500.0}, {20.0, 12.0, 4.0}, {0.0, 0.0, 1.0}, 30.0, 64, 64);
+    const glm::dvec3 centre = camera.toView(glm::dvec3(v.indexToWorld * glm::dvec4(20.0, 12.0, 4.0, 1.0)));
+    const double spacing = v.voxelSize * camera.focal() / centre.z;  // ≈ projected voxel spacing (px)
+    for (int run = 0; run < 6; ++run) {
+        const int level = 1 + run / 2, side = 1 << level;  // every level twice: vectorised sums, scalar sums
+        StreamOptions o;
+        o.vectorLeafMoments = run % 2 == 0;
+        o.pointBelowPx = INFINITY;
+        o.lodCellPx = (side + 0.5) * spacing * 1.02;  // admits 2^level, not 2^(level+1)
+        o.pointPrefilterVariance = 1.0;
+        VoxelStream stream(v, camera, table, o);
+        VoxelBatch batch, all;
+        while (stream.next(batch))
+            for (size_t i = 0; i < batch.size(); ++i) {
+                all.viewPos.push_back(batch.viewPos[i]), all.sigma.push_back(batch.sigma[i]);
+                all.color.push_back(batch.color[i]), all.spread.push_back(batch.spread[i]);
+                all.members.push_back(batch.members[i]);
+            }
+        // Brute force, in double, per cell.
+        struct Cell { double m = 0; glm::dvec3 e{0.0}, p{0.0}; glm::dmat3 pp{0.0}; uint32_t n = 0; };
+        std::map<std::tuple<int, int, int>, Cell> cells;
+        for (auto it = grid->tree().cbeginValueOn(); it; ++it) {
+            const openvdb::Coord c = it.getCoord();
+            const Classified k = table(*it);
+            const glm::dvec3 p = camera.toView(glm::dvec3(v.indexToWorld * glm::dvec4(c.x(), c.y(), c.z(), 1.0)));
+            Cell& cell = cells[{c.x() >> level, c.y() >> level, c.z() >> level}];
+            cell.m += k.sigma, cell.e += double(k.sigma) * glm::dvec3(k.color), cell.p += double(k.sigma) * p;
+            cell.pp += double(k.sigma) * glm::outerProduct(p, p);
+            ++cell.n;
+        }
+        ASSERT_EQ(all.viewPos.size(), cells.size()) << "level " << level;
+        for (const auto& [key, cell] : cells) {
+            const glm::dvec3 mu = cell.p / cell.m;
+            size_t best = 0;
+            for (size_t i = 1; i < all.viewPos.size(); ++i)
+                if (glm::length(glm::dvec3(all.viewPos[i]) - mu) < glm::length(glm::dvec3(all.viewPos[best]) - mu)) best = i;
+            SCOPED_TRACE("level " + std::to_string(level) + (o.vectorLeafMoments ? " (vectorised)" : ""));
+            EXPECT_LT(glm::length(glm::dvec3(all.viewPos[best]) - mu), 1e-3 * v.voxelSize);
+            EXPECT_NEAR(all.sigma[best], cell.m, 1e-5 * cell.m);
+            EXPECT_EQ(all.members[best], cell.n);
+            const glm::dvec3 color = cell.e / cell.m;
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(all.color[best][c], color[c], 1e-5);
+            const glm::dmat3 cov = cell.pp / cell.m - glm::outerProduct(mu, mu);
+            const double f = camera.focal();
+            const glm::dvec3 jx(f / mu.z, 0.0, -f * mu.x / (mu.z * mu.z)), jy(0.0, f / mu.z, -f * mu.y / (mu.z * mu.z));
+            const double spread = 0.5 * (glm::dot(jx, cov * jx) + glm::dot(jy, cov * jy));
+            EXPECT_NEAR(all.spread[best], spread, 2e-3 * spread + 1e-9);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace vdbsplat
+
+#include "volume/leaf_moments.h"
+
+namespace vdbsplat {
+namespace {
+
+// The vectorised whole-leaf sums against the same sums in double, one voxel at a time: a
+// partly active leaf (mask words), a dense one (no mask), values outside the table's range,
+// NaN and infinity (σ = 0, not counted), and a colour-varying table.
+TEST(LeafMoments, MatchTheSumsVoxelByVoxel) {
+    if (!leafMomentsSupported()) GTEST_SKIP() << "this CPU's vectors do not hold whole 8-voxel rows (scalar sums only)";
+    std::vector<Classified> entries(ClassificationTable::kSize);
+    for (int i = 0; i < ClassificationTable::kSize; ++i) {
+        const float t = float(i) / float(ClassificationTable::kSize - 1);
+        entries[size_t(i)] = {glm::vec3(t, 1.f - t, 0.3f + 0.4f * t * t), t < 0.1f ? 0.f : 0.02f + 2.f * t};
+    }
+    const ClassificationTable table(entries, -0.5f, 2.f);
+    uint32_t state = 99;
+    const auto rnd = [&] { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1 << 24); };
+    for (int trial = 0; trial < 40; ++trial) {
+        std::array<float, 512> values;
+        std::array<uint64_t, 8> words{};
+        for (int n = 0; n < 512; ++n) {
+            values[size_t(n)] = -1.f + 4.f * rnd();
+            if (n % 97 == trial % 97) values[size_t(n)] = std::numeric_limits<float>::quiet_NaN();
+            if (n % 89 == trial % 89) values[size_t(n)] = -std::numeric_limits<float>::infinity();
+            if (rnd() < 0.7f) words[size_t(n >> 6)] |= uint64_t(1) << (n & 63);
+        }
+        const bool dense = trial % 4 == 0;
+        const int level = 1 + trial % 3, side = 1 << level, cells = 8 >> level;
+        const float half = 0.5f * float(side - 1);
+        std::array<CellMoments, 64> got;
+        leafMoments(values.data(), dense ? nullptr : words.data(), table, level, got.data());
+        struct Sums { double m = 0, e[3] = {}, f[3] = {}, s2[6] = {}; uint32_t count = 0; };
+        std::array<Sums, 64> want{};
+        for (int n = 0; n < 512; ++n) {
+            if (!dense && !(words[size_t(n >> 6)] >> (n & 63) & 1)) continue;
+            const Classified c = table(values[size_t(n)]);
+            if (!(c.sigma > 0.f)) continue;
+            const int x = n >> 6, y = (n >> 3) & 7, z = n & 7;
+            Sums& w = want[size_t(((x >> level) * cells + (y >> level)) * cells + (z >> level))];
+            const double d[3] = {(x & (side - 1)) - half, (y & (side - 1)) - half, (z & (side - 1)) - half}, s = c.sigma;
+            w.m += s, ++w.count;
+            for (int k = 0; k < 3; ++k) w.e[k] += s * c.color[k], w.f[k] += s * d[k];
+            w.s2[0] += s * d[0] * d[0], w.s2[1] += s * d[1] * d[1], w.s2[2] += s * d[2] * d[2];
+            w.s2[3] += s * d[0] * d[1], w.s2[4] += s * d[0] * d[2], w.s2[5] += s * d[1] * d[2];
+        }
+        uint32_t total = 0;
+        for (int cell = 0; cell < cells * cells * cells; ++cell) {
+            SCOPED_TRACE("trial " + std::to_string(trial) + ", level " + std::to_string(level) + ", cell " + std::to_string(cell));
+            const Sums& w = want[size_t(cell)];
+            const CellMoments& g = got[size_t(cell)];
+            total += w.count;
+            EXPECT_EQ(g.n, w.count);
+            const double tol = 1e-6 * w.m * 16.0 + 1e-7;  // float sums of ≤ 512 terms, |offsets| ≤ 3.5
+            EXPECT_NEAR(g.m, w.m, 1e-6 * w.m + 1e-7);
+            for (int k = 0; k < 3; ++k) EXPECT_NEAR(g.emission[k], w.e[k], 1e-6 * w.m + 1e-7) << k;
+            for (int k = 0; k < 3; ++k) EXPECT_NEAR(g.first[k], w.f[k], tol) << k;
+            const float g2[6] = {g.xx, g.yy, g.zz, g.xy, g.xz, g.yz};
+            for (int k = 0; k < 6; ++k) EXPECT_NEAR(g2[k], w.s2[k], tol) << k;
+        }
+        ASSERT_GT(total, 100u);
+    }
+}
+
+}  // namespace
+}  // namespace vdbsplat

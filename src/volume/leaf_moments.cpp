@@ -1,0 +1,127 @@
+// volume/leaf_moments.cpp — leafMoments with Google Highway (see leaf_moments.h). Compiled once
+// per SIMD target (foreach_target.h); HWY_DYNAMIC_DISPATCH picks the best the CPU has.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "volume/leaf_moments.cpp"
+#include <hwy/foreach_target.h>  // must come before highway.h
+#include <hwy/highway.h>
+
+#include <cstring>
+
+#include "volume/leaf_moments.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace vdbsplat {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+constexpr int kLeafSide = 8;
+
+/// Whole rows per vector (8 or 16 lanes): every lane keeps its z, so its cell along z, from one
+/// vector to the next. Narrower or wider targets take the scalar sums (leafMomentsSupported).
+template <class D>
+constexpr bool kRowLanes = hn::MaxLanes(D()) == 8 || hn::MaxLanes(D()) == 16;
+
+template <class D>
+bool Supported(D) {
+    if constexpr (kRowLanes<D>) return hn::Lanes(D()) == hn::MaxLanes(D());
+    return false;
+}
+
+bool LeafMomentsSupported() { return Supported(hn::ScalableTag<float>()); }
+
+void LeafMomentsImpl(const float* values, const uint64_t* maskWords, const ClassificationTable& table, int level,
+                     CellMoments* out) {
+    const hn::ScalableTag<float> d;
+    if constexpr (kRowLanes<decltype(d)>) {
+        const hn::RebindToSigned<decltype(d)> di;
+        using V = hn::Vec<decltype(d)>;
+        const int lanes = int(hn::Lanes(d)), rowsPerVector = lanes / kLeafSide;
+        const int side = 1 << level, cells = kLeafSide >> level;
+        const float half = 0.5f * float(side - 1);
+        // The baked entries as floats: colour r, g, b, then σ, four per entry (Classified).
+        static_assert(sizeof(Classified) == 4 * sizeof(float), "Classified is {vec3 colour, float σ}");
+        const float* entries = reinterpret_cast<const float*>(table.entries());
+        const V scale = hn::Set(d, table.scale()), offset = hn::Set(d, table.offset());
+        const V zero = hn::Zero(d), top = hn::Set(d, float(ClassificationTable::kSize - 1));
+        const auto lastLeft = hn::Set(di, ClassificationTable::kSize - 2), four = hn::Set(di, 4);
+        // Per lane: its z (lane mod 8) and row within the vector (lane / 8).
+        const auto lane = hn::Iota(di, 0);
+        const auto laneZ = hn::And(lane, hn::Set(di, kLeafSide - 1));
+        const V dz = hn::Sub(hn::ConvertTo(d, hn::And(laneZ, hn::Set(di, side - 1))), hn::Set(d, half));
+        const V laneRow = hn::ConvertTo(d, hn::ShiftRight<3>(lane));
+        for (int cx = 0; cx < cells; ++cx)
+            for (int cy = 0; cy < cells; ++cy) {
+                V S = zero, Sx = zero, Sy = zero, Sz = zero, Sxx = zero, Syy = zero, Szz = zero, Sxy = zero,
+                  Sxz = zero, Syz = zero, Er = zero, Eg = zero, Eb = zero, count = zero;
+                for (int x = cx * side; x < (cx + 1) * side; ++x)
+                    for (int y = cy * side; y < (cy + 1) * side; y += rowsPerVector) {
+                        const int n = x * 64 + y * 8;
+                        const V value = hn::LoadU(d, values + n);
+                        auto active = hn::IsFinite(value);
+                        if (maskWords) {
+                            const uint64_t bits = maskWords[x] >> (n & 63);
+                            uint8_t bytes[8];
+                            std::memcpy(bytes, &bits, sizeof bytes);
+                            active = hn::And(active, hn::LoadMaskBits(d, bytes));
+                        }
+                        // ClassificationTable::operator(): x = clamp(v·scale + offset), i = min(⌊x⌋,
+                        // size − 2), the two entries lerped by x − i (the same float operations).
+                        const V t0 = hn::IfThenElseZero(active, hn::Min(hn::Max(hn::Add(hn::Mul(value, scale), offset), zero), top));
+                        const auto i = hn::Min(hn::ConvertTo(di, t0), lastLeft);
+                        const V t = hn::Sub(t0, hn::ConvertTo(d, i));
+                        const auto a = hn::ShiftLeft<2>(i), b = hn::Add(a, four);
+                        const auto lerp = [&](int channel) {
+                            const V lo = hn::GatherIndex(d, entries + channel, a), hi = hn::GatherIndex(d, entries + channel, b);
+                            return hn::Add(lo, hn::Mul(t, hn::Sub(hi, lo)));
+                        };
+                        const V sigma = hn::IfThenElseZero(active, lerp(3));
+                        count = hn::Add(count, hn::IfThenElseZero(hn::Gt(sigma, zero), hn::Set(d, 1.f)));
+                        Er = hn::MulAdd(sigma, lerp(0), Er);
+                        Eg = hn::MulAdd(sigma, lerp(1), Eg);
+                        Eb = hn::MulAdd(sigma, lerp(2), Eb);
+                        const V dx = hn::Set(d, float(x & (side - 1)) - half);
+                        const V dy = hn::Add(hn::Set(d, float(y & (side - 1)) - half), laneRow);
+                        const V sx = hn::Mul(sigma, dx), sy = hn::Mul(sigma, dy), sz = hn::Mul(sigma, dz);
+                        S = hn::Add(S, sigma);
+                        Sx = hn::Add(Sx, sx), Sy = hn::Add(Sy, sy), Sz = hn::Add(Sz, sz);
+                        Sxx = hn::MulAdd(sx, dx, Sxx), Syy = hn::MulAdd(sy, dy, Syy), Szz = hn::MulAdd(sz, dz, Szz);
+                        Sxy = hn::MulAdd(sx, dy, Sxy), Sxz = hn::MulAdd(sx, dz, Sxz), Syz = hn::MulAdd(sy, dz, Syz);
+                    }
+                // Each cell along z is the lanes whose z lies in it.
+                for (int cz = 0; cz < cells; ++cz) {
+                    const auto in = hn::RebindMask(d, hn::Eq(hn::And(laneZ, hn::Set(di, ~(side - 1))),
+                                                             hn::Set(di, cz * side)));
+                    const auto sum = [&](V v) { return hn::GetLane(hn::SumOfLanes(d, hn::IfThenElseZero(in, v))); };
+                    CellMoments& m = out[(cx * cells + cy) * cells + cz];
+                    m.m = sum(S);
+                    m.emission = glm::vec3(sum(Er), sum(Eg), sum(Eb));
+                    m.first = glm::vec3(sum(Sx), sum(Sy), sum(Sz));
+                    m.xx = sum(Sxx), m.yy = sum(Syy), m.zz = sum(Szz);
+                    m.xy = sum(Sxy), m.xz = sum(Sxz), m.yz = sum(Syz);
+                    m.n = uint32_t(sum(count));
+                }
+            }
+    } else {
+        (void)d, (void)values, (void)maskWords, (void)table, (void)level, (void)out;
+    }
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace vdbsplat
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace vdbsplat {
+
+HWY_EXPORT(LeafMomentsImpl);
+HWY_EXPORT(LeafMomentsSupported);
+
+bool leafMomentsSupported() { return HWY_DYNAMIC_DISPATCH(LeafMomentsSupported)(); }
+
+void leafMoments(const float* values, const uint64_t* maskWords, const ClassificationTable& table, int level,
+                 CellMoments* out) {
+    HWY_DYNAMIC_DISPATCH(LeafMomentsImpl)(values, maskWords, table, level, out);
+}
+
+}  // namespace vdbsplat
+#endif  // HWY_ONCE
