@@ -233,10 +233,13 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out) const {
 /// for inactive voxels. Rows without an active voxel are skipped.
 namespace {
 template <typename Fn>
-void forEachRow(const auto& b, const Volume& volume, const ClassificationTable& table, const VoxelShader* shader, Fn&& fn) {
+void forEachRow(const auto& b, const Volume& volume, const ClassificationTable& table, const VoxelShader* shader,
+                const EmissionSource* emission, Fn&& fn) {
     constexpr int kDim = kBlockDim;
     std::optional<VoxelShader::Accessor> acc;
     if (shader) acc.emplace(volume.grid->tree());  // per block: blocks run on any thread
+    std::optional<EmissionSource::Accessor> emissionAcc;
+    if (emission) emissionAcc.emplace(emission->accessor());
     std::array<float, kDim> sigma;
     std::array<glm::vec3, kDim> color;
     const float* values = b.leaf ? b.leaf->buffer().data() : nullptr;
@@ -256,6 +259,8 @@ void forEachRow(const auto& b, const Volume& volume, const ClassificationTable& 
                 Classified cls = table(value);
                 if (shader && cls.sigma > 0.f)
                     cls = applyShading(cls, (*shader)(*acc, b.leaf, n, b.origin.offsetBy(x, y, z), value));
+                // Emission after shading, as forEachActive (docs/emission.md).
+                if (emission) cls = applyEmission(cls, emission->at(*emissionAcc, b.origin.offsetBy(x, y, z)));
                 sigma[size_t(z)] = cls.sigma, color[size_t(z)] = cls.color;
             }
             fn(x, y, sigma, color);
@@ -275,15 +280,15 @@ void VoxelStream::extractAggregates(const Block& b, VoxelBatch& out) const {
     const int level = b.lodLevel, side = 1 << level, cells = b.dim >> level;
     const float half = 0.5f * float(side - 1);
     std::array<Moments, 64> acc{};  // cells ≤ (8/2)³
-    // Unshaded leaves: the vectorised sums (leaf_moments.h; 2–4× the scalar rows).
-    const bool vectorised = level >= 1 && b.leaf && !shader_ && table_.entries() && options_.vectorLeafMoments &&
-                            leafMomentsSupported();
+    // Leaves without shading or emission: the vectorised sums (leaf_moments.h; 2–4× the scalar rows).
+    const bool vectorised = level >= 1 && b.leaf && !shader_ && !emission_ && table_.entries() &&
+                            options_.vectorLeafMoments && leafMomentsSupported();
     if (vectorised) {
         const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE;
         std::array<uint64_t, 8> words;
         for (int x = 0; x < 8; ++x) words[size_t(x)] = b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));
         leafMoments(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, level, acc.data());
-    } else forEachRow(b, volume_, table_, shader_, [&](int x, int y, const std::array<float, kBlockDim>& sigma, const std::array<glm::vec3, kBlockDim>& color) {
+    } else forEachRow(b, volume_, table_, shader_, emission_, [&](int x, int y, const std::array<float, kBlockDim>& sigma, const std::array<glm::vec3, kBlockDim>& color) {
         const float dx = float(x & (side - 1)) - half, dy = float(y & (side - 1)) - half;
         Moments* row = &acc[size_t(((x >> level) * cells + (y >> level)) * cells)];
         for (int cz = 0; cz < cells; ++cz) {
