@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 CI_MODE=0
 if [ "${1:-}" = "--ci" ]; then CI_MODE=1; SECONDS_EACH=0; shift; else SECONDS_EACH=${1:-60}; shift || true; fi
 # Runs per target in --ci mode (executions per second differ by 1000x: fuzz_vdb forks a reader).
-declare -A CI_RUNS=([fuzz_vdb]=300 [fuzz_camera_path]=30000 [fuzz_raw]=3000 [fuzz_nrrd]=1500 [fuzz_vti]=1500 [fuzz_image]=100 [fuzz_tables]=40000 [fuzz_transfer_function]=50000)
+declare -A CI_RUNS=([fuzz_vdb]=300 [fuzz_camera_path]=30000 [fuzz_raw]=3000 [fuzz_nrrd]=1500 [fuzz_vti]=1500 [fuzz_image]=100 [fuzz_tables]=40000 [fuzz_transfer_function]=50000 [fuzz_study_spec]=50000)
 BUILD_DIR=${ASAN_BUILD_DIR:-build-asan}
 scripts/setup.sh
 TARGETS=("$@")

@@ -18,5 +18,6 @@ int runTables(const Argv& args);    ///< vdbsplat tables --out DIR | --check
 int runBench(const Argv& args);     ///< vdbsplat bench FILE.vdb …
 int runCompare(const Argv& args);   ///< vdbsplat compare A B (PSNR, …)
 int runAnimate(const Argv& args);   ///< vdbsplat animate FILE.vdb -o DIR (zoom, orbit or keyframes)
+int runStudy(const Argv& args);     ///< vdbsplat study FILE.vdb… -o DIR (antialiasing study and report)
 
 }  // namespace vdbsplat::cli

@@ -17,6 +17,7 @@ const char* kUsage =
     "commands:\n"
     "  render    render a .vdb grid to PNG or EXR (reference, hybrid, splat, point, ewa, swan, none)\n"
     "  animate   render a camera path (zoom, orbit, keyframes) to frames, with per-frame stats\n"
+    "  study     antialiasing study: every mode and view against the reference, HTML report\n"
     "  info      describe every grid in a .vdb file\n"
     "  generate  write a test volume (checkerbox, marschner-lobb, sphere, cloud)\n"
     "  convert   turn a raw volume (x fastest) into a sparse .vdb\n"
@@ -28,6 +29,7 @@ int dispatch(const std::string& command, const vdbsplat::cli::Argv& args) {
     using namespace vdbsplat::cli;
     if (command == "render") return runRender(args);
     if (command == "animate") return runAnimate(args);
+    if (command == "study") return runStudy(args);
     if (command == "info") return runInfo(args);
     if (command == "generate") return runGenerate(args);
     if (command == "convert") return runConvert(args);
