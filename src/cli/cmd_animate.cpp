@@ -86,7 +86,7 @@ const char* kHelp =
     "  --mp4              also encode DIR/animation.mp4 with ffmpeg when it is on PATH (else a note)\n"
     "\n"
     "render flags (as vdbsplat render):\n"
-    "  --grid NAME        grid to render (default: the first float or double grid)\n"
+    "  --grid NAME        grid to render (default: the grid named density, else the first float or double grid)\n"
     "  --mode MODE        hybrid (default) | splat | point | ewa | swan | none | reference\n"
     "                     ewa: Zwicker et al. 2001 affine (Jacobian) splats + low-pass; swan: Swan et\n"
     "                     al. 1997, minified footprints stretched to the pixel filter; none: no\n"

@@ -47,7 +47,7 @@ const char* kHelp =
     "then the median of those ratios over the views. Runs are interleaved (for each run: for\n"
     "each view: for each mode) so machine drift affects every mode alike. A benchmark, not a test.\n"
     "\n"
-    "  --grid NAME          grid to render (default: the first float or double grid)\n"
+    "  --grid NAME          grid to render (default: the grid named density, else the first float or double grid)\n"
     "  --tf PRESET|FILE     transfer function: grey (default), ct-bone, fire, or a JSON file\n"
     "  --size WxH           image size in pixels (default 400x400)\n"
     "  --runs N             timed runs per view and mode, 1..1000 (default 5)\n"

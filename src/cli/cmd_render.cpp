@@ -27,7 +27,7 @@ const char* kHelp =
     "usage: vdbsplat render FILE.vdb -o OUT.png|OUT.exr [options]\n"
     "\n"
     "  -o FILE            output image: .png (8-bit sRGB over black) or .exr (float linear RGBA + metadata)\n"
-    "  --grid NAME        grid to render (default: the first float or double grid)\n"
+    "  --grid NAME        grid to render (default: the grid named density, else the first float or double grid)\n"
     "  --mode MODE        hybrid (default) | splat | point | ewa | swan | none | reference\n"
     "                     ewa: Zwicker et al. 2001 affine (Jacobian) splats + low-pass; swan: Swan et\n"
     "                     al. 1997, minified footprints stretched to the pixel filter; none: no\n"

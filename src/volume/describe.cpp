@@ -127,10 +127,11 @@ std::string usage(const openvdb::GridPtrVec& grids, size_t i) {
     if (g.activeVoxelCount() == 0) return "not renderable (no active voxels)";
     const std::string problem = transformProblem(g.transform());
     if (!problem.empty()) return "not renderable (" + printable(problem) + ")";
-    size_t firstScalar = grids.size();
-    for (size_t k = 0; k < grids.size() && firstScalar == grids.size(); ++k)
-        if (isScalar(*grids[k])) firstScalar = k;
-    std::string out = "density (--grid " + printable(g.getName()) + (i == firstScalar ? ", the default)" : ")");
+    std::vector<std::string> names;
+    std::vector<bool> scalar;
+    for (const auto& grid : grids) names.push_back(grid->getName()), scalar.push_back(isScalar(*grid));
+    const size_t fallback = defaultGridIndex(names, scalar);
+    std::string out = "density (--grid " + printable(g.getName()) + (i == fallback ? ", the default)" : ")");
     std::string partners;
     for (size_t k = 0; k < grids.size(); ++k)
         if (k != i && isScalar(*grids[k]) && grids[k]->transform() == g.transform() && grids[k]->activeVoxelCount() > 0)

@@ -34,7 +34,7 @@ uint64_t estimatedLeaves(const openvdb::GridBase& meta) {
     return uint64_t(bytes->value()) / perLeaf;
 }
 
-/// Opens @p path and reads the grid to render: @p gridName, or the first float or double grid.
+/// Opens @p path and reads the grid to render: @p gridName, or defaultGridIndex's.
 /// @p hint, if given, gets the grid's estimated leaf count before its values are read.
 openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::string& gridName,
                                         const std::function<void(uint64_t)>& hint = {}) {
@@ -44,8 +44,13 @@ openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::stri
     try {
         const auto metas = file.readAllGridMetadata();
         std::string chosen;
-        for (const auto& meta : *metas) {
-            if (!gridName.empty() ? meta->getName() == gridName : isScalarType(meta->valueType())) {
+        std::vector<std::string> names;
+        std::vector<bool> scalar;
+        for (const auto& meta : *metas) names.push_back(meta->getName()), scalar.push_back(isScalarType(meta->valueType()));
+        const size_t fallback = defaultGridIndex(names, scalar);
+        for (size_t k = 0; k < metas->size(); ++k) {
+            const auto& meta = (*metas)[k];
+            if (!gridName.empty() ? meta->getName() == gridName : k == fallback) {
                 if (!isScalarType(meta->valueType()))
                     throw Error(path + ": grid '" + gridName + "' holds " + meta->valueType() +
                                 " values; only float and double grids can be rendered");
@@ -122,6 +127,17 @@ void sanitizeValues(Volume& v) {
 }
 
 }  // namespace
+
+size_t defaultGridIndex(const std::vector<std::string>& names, const std::vector<bool>& scalar) {
+    size_t first = names.size();
+    for (size_t k = 0; k < names.size(); ++k) {
+        if (!scalar[k]) continue;
+        if (names[k] == "density") return k;
+        if (first == names.size()) first = k;
+    }
+    return first;
+}
+
 
 std::string transformProblem(const openvdb::math::Transform& transform) {
     try {

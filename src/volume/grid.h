@@ -55,6 +55,12 @@ Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label = "<mem
 /// (the check loadVolume applies; `vdbsplat info` reports it).
 std::string transformProblem(const openvdb::math::Transform& transform);
 
+/// The grid rendered when no --grid is given: the float or double grid named "density" (the name
+/// VFX tools give the extinction grid, wherever it stands in the file: EmberGen writes
+/// flame, temperature, density), else the first float or double grid. @p names and @p scalar
+/// describe the file's grids in order; returns names.size() when none is scalar.
+size_t defaultGridIndex(const std::vector<std::string>& names, const std::vector<bool>& scalar);
+
 /// @brief A human-readable description of every grid in @p path (`vdbsplat info`).
 /// @throw Error as loadVolume for unreadable files.
 std::string describeFile(const std::string& path);

@@ -456,3 +456,36 @@ TEST_F(Grid, WriteVolumeIsAtomicAndRoundTrips) {
 
 }  // namespace
 }  // namespace vdbsplat
+
+namespace vdbsplat {
+namespace {
+
+// With no --grid, a float grid named "density" is rendered wherever it stands in the file (VFX
+// exports list flame and temperature first); without one, the first float or double grid; `info`
+// marks the same grid as the default.
+TEST(GridChoice, DefaultGridPrefersDensity) {
+    EXPECT_EQ(defaultGridIndex({"flame", "temperature", "density"}, {true, true, true}), 2u);
+    EXPECT_EQ(defaultGridIndex({"vel", "flame", "heat"}, {false, true, true}), 1u);
+    EXPECT_EQ(defaultGridIndex({"density", "smoke"}, {false, true}), 1u);  // a vector "density" is not rendered
+    EXPECT_EQ(defaultGridIndex({"vel"}, {false}), 1u);
+    initOpenVdb();
+    const auto grid = [](const std::string& name, float value) {
+        auto g = openvdb::FloatGrid::create(0.f);
+        g->setName(name);
+        g->tree().setValueOn(openvdb::Coord(0, 0, 0), value);
+        return g;
+    };
+    const std::string path = (std::filesystem::temp_directory_path() / "vdbsplat_default_grid.vdb").string();
+    writeVolumes(path, {grid("flame", 0.25f), grid("temperature", 0.5f), grid("density", 0.75f)});
+    EXPECT_EQ(loadVolume(path).name, "density");
+    EXPECT_EQ(loadVolume(path, "flame").name, "flame");
+    const std::string info = describeFile(path);
+    EXPECT_NE(info.find("density (--grid density, the default)"), std::string::npos) << info;
+    EXPECT_EQ(info.find("density (--grid flame, the default)"), std::string::npos) << info;
+    writeVolumes(path, {grid("flame", 0.25f), grid("heat", 0.5f)});
+    EXPECT_EQ(loadVolume(path).name, "flame");
+    std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace vdbsplat
