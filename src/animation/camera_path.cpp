@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "util/error.h"
+#include "util/parse.h"
 
 namespace vdbsplat::animation {
 
@@ -18,26 +19,6 @@ namespace {
 void checkFrames(long long frames, const std::string& flag) {
     if (frames < 1 || frames > kMaxFrames)
         throw Error(flag + ": must be in 1.." + std::to_string(kMaxFrames) + ", got " + std::to_string(frames));
-}
-
-/// Largest nesting depth of [ and { outside strings; stops early past @p limit.
-int nestingDepth(const std::string& text, int limit) {
-    int depth = 0, deepest = 0;
-    bool inString = false, escaped = false;
-    for (const char c : text) {
-        if (inString) {
-            if (escaped) escaped = false;
-            else if (c == '\\') escaped = true;
-            else if (c == '"') inString = false;
-            continue;
-        }
-        if (c == '"') inString = true;
-        else if (c == '[' || c == '{') {
-            deepest = std::max(deepest, ++depth);
-            if (deepest > limit) return deepest;
-        } else if (c == ']' || c == '}') --depth;
-    }
-    return deepest;
 }
 
 std::string where(const std::string& name, size_t k) { return name + ": keyframe " + std::to_string(k); }
@@ -129,7 +110,7 @@ std::vector<CameraKey> parseKeyframes(const std::string& text, const std::string
                                       double defaultFov) {
     if (text.size() > kMaxPathFileBytes)
         throw Error(name + ": larger than " + std::to_string(kMaxPathFileBytes >> 20) + " MB, not a keyframe file");
-    if (nestingDepth(text, kMaxPathNesting) > kMaxPathNesting)
+    if (jsonNestingPastLimit(text, kMaxPathNesting) != std::string::npos)
         throw Error(name + ": JSON nested deeper than " + std::to_string(kMaxPathNesting) +
                     " levels (expected [ {\"eye\": [x, y, z], …}, … ])");
     nlohmann::json j;

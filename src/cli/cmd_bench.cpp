@@ -71,23 +71,6 @@ constexpr int kMaxRuns = 1000;
 constexpr int kMaxWarmup = 100;
 constexpr size_t kMaxDistances = 32;
 
-/// Splits "a,b,c" into its items; @throw Error naming @p flag for an empty list or item.
-std::vector<std::string> splitList(const std::string& text, const std::string& flag) {
-    std::vector<std::string> items;
-    size_t start = 0;
-    while (true) {
-        const size_t comma = text.find(',', start);
-        std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-        const size_t b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
-        item = b == std::string::npos ? "" : item.substr(b, e - b + 1);
-        if (item.empty()) throw Error(flag + ": empty item in '" + text + "' (expected a comma-separated list)");
-        items.push_back(item);
-        if (comma == std::string::npos) break;
-        start = comma + 1;
-    }
-    return items;
-}
-
 std::vector<RenderMode> parseModes(const std::string& text) {
     std::vector<RenderMode> modes;
     for (const std::string& item : splitList(text, "--modes")) {

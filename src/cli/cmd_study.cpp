@@ -168,7 +168,7 @@ std::vector<KernelPlan> kernelsFrom(const Args& args) {
     const std::vector<std::string> argv = renderArgv(args);
     std::vector<KernelPlan> kernels;
     if (auto v = args.get("--kernels")) {
-        for (const std::string& k : study::splitList(*v, "--kernels")) {
+        for (const std::string& k : splitList(*v, "--kernels")) {
             for (const KernelPlan& p : kernels)
                 if (p.name == k) throw Error("--kernels: '" + k + "' given more than once");
             if (study::safeId(k) != k) throw Error("--kernels: '" + printable(k) + "' is not a kernel name");
@@ -185,7 +185,7 @@ std::vector<KernelPlan> kernelsFrom(const Args& args) {
 std::vector<RenderMode> modesFrom(const Args& args) {
     std::vector<std::string> names;
     if (auto v = args.get("--modes")) {
-        names = study::splitList(*v, "--modes");
+        names = splitList(*v, "--modes");
     } else {
         for (const char* c : kCandidateModes) try {
                 (void)parseRenderMode(c);
@@ -215,7 +215,7 @@ std::vector<View> viewsFrom(const Args& args) {
     std::vector<View> views;
     bool ladder = false;
     if (auto v = args.get("--views")) {
-        for (const std::string& item : study::splitList(*v, "--views")) {
+        for (const std::string& item : splitList(*v, "--views")) {
             if (item == "standard") {
                 for (const View& s : study::standardViews()) views.push_back(s);
             } else if (item == "ladder") {
@@ -231,7 +231,7 @@ std::vector<View> viewsFrom(const Args& args) {
     }
     if (args.has("--base") && !ladder) throw Error("--base: needs --views ladder");
     if (auto v = args.get("--distances"))
-        for (const std::string& item : study::splitList(*v, "--distances")) {
+        for (const std::string& item : splitList(*v, "--distances")) {
             const double d = parseDouble(item, "--distances");
             if (!(d >= study::kMinDistance && d < 1e6))
                 throw Error("--distances: each must be a number in [0.0001, 1e6), got '" + printable(item) + "'");
@@ -258,7 +258,7 @@ Options optionsFrom(const Args& args) {
     o.kernels = kernelsFrom(args);
     if (auto v = args.get("--tfs")) {
         if (args.has("--tf")) throw Error("--tfs: not with --tf (choose one)");
-        o.tfs = study::splitList(*v, "--tfs");
+        o.tfs = splitList(*v, "--tfs");
         o.tfsGiven = true;
         if (o.tfs.size() != o.inputs.size())
             throw Error("--tfs: " + std::to_string(o.tfs.size()) + " transfer functions for " +

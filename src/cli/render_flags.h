@@ -13,6 +13,22 @@
 #include "volume/grid.h"
 #include "volume/transfer_function.h"
 
+/// The help lines of the flags that choose what is rendered and how (--grid, --mode, --size,
+/// --kernel, --tf), one text for render and animate. A string-literal macro so each command's
+/// help stays one literal.
+#define VDBSPLAT_SCENE_FLAGS_HELP \
+    "  --grid NAME        grid to render (default: the grid named density, else the first float or double grid)\n" \
+    "  --mode MODE        hybrid (default) | splat | point | ewa | swan | none | reference\n" \
+    "                     ewa: Zwicker et al. 2001 affine (Jacobian) splats + low-pass; swan: Swan et\n" \
+    "                     al. 1997, minified footprints stretched to the pixel filter; none: no\n" \
+    "                     low-pass (splats without it, points to the nearest pixel); ewa, swan and\n" \
+    "                     none ignore --filter-order/--subpixels (docs/modes.md)\n" \
+    "  --size WxH         image size in pixels (default 400x400)\n" \
+    "  --kernel K         reconstruction kernel, every mode and the reference: gaussian (default,\n" \
+    "                     s_g 0.65, R 2) | gaussian-sharp (s_g 0.5, R 1.55: less blur when\n" \
+    "                     magnified, more ripple; docs/kernel.md)\n" \
+    "  --tf PRESET|FILE   transfer function: grey (default), ct-bone, fire, or a JSON file\n"
+
 namespace vdbsplat::cli {
 
 /// The value flags settingsFromFlags() reads (without -o and command-specific ones).

@@ -38,26 +38,6 @@ std::string keyList() {
     return s;
 }
 
-/// Largest nesting depth of [ and { outside strings; stops early past @p limit.
-int nestingDepth(const std::string& text, int limit) {
-    int depth = 0, deepest = 0;
-    bool inString = false, escaped = false;
-    for (const char c : text) {
-        if (inString) {
-            if (escaped) escaped = false;
-            else if (c == '\\') escaped = true;
-            else if (c == '"') inString = false;
-            continue;
-        }
-        if (c == '"') inString = true;
-        else if (c == '[' || c == '{') {
-            deepest = std::max(deepest, ++depth);
-            if (deepest > limit) return deepest;
-        } else if (c == ']' || c == '}') --depth;
-    }
-    return deepest;
-}
-
 std::string numberText(const nlohmann::json& v, const std::string& at) {
     if (!v.is_number()) throw Error(at + ": expected a number, got " + std::string(v.type_name()));
     const double d = v.get<double>();
@@ -123,7 +103,7 @@ SpecArgument argumentFor(const std::string& key, Kind kind, const char* flag, co
 std::vector<SpecArgument> parseSpec(const std::string& text, const std::string& name) {
     if (text.size() > kMaxSpecBytes)
         throw Error(name + ": larger than " + std::to_string(kMaxSpecBytes >> 20) + " MB, not a study file");
-    if (nestingDepth(text, kMaxSpecNesting) > kMaxSpecNesting)
+    if (jsonNestingPastLimit(text, kMaxSpecNesting) != std::string::npos)
         throw Error(name + ": JSON nested deeper than " + std::to_string(kMaxSpecNesting) + " levels (expected {\"volumes\": [...], ...})");
     nlohmann::json j;
     try {

@@ -55,22 +55,6 @@ std::string viewId(double distance) {
     return id;
 }
 
-std::vector<std::string> splitList(const std::string& text, const std::string& flag) {
-    std::vector<std::string> items;
-    size_t start = 0;
-    while (true) {
-        const size_t comma = text.find(',', start);
-        std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-        const size_t b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
-        item = b == std::string::npos ? "" : item.substr(b, e - b + 1);
-        if (item.empty()) throw Error(flag + ": empty item in '" + text + "' (expected a comma-separated list)");
-        items.push_back(item);
-        if (comma == std::string::npos) break;
-        start = comma + 1;
-    }
-    return items;
-}
-
 std::string safeId(const std::string& text) {
     std::string id;
     for (const char c : text) {

@@ -43,9 +43,6 @@ std::vector<View> withoutRepeats(const std::vector<View>& views);
 /// @brief "d" + the distance in %g with '.' as '_' and '-' as 'm' ("d0_35", "d1e+06" → "d1ep06").
 std::string viewId(double distance);
 
-/// @brief Splits "a,b,c" into trimmed items.
-/// @throw Error "<flag>: empty item in '<text>' …" for an empty list or an empty item.
-std::vector<std::string> splitList(const std::string& text, const std::string& flag);
 
 /// @brief A file-safe id from @p text: letters, digits, '-' and '_' kept, anything else '_',
 /// at most 48 characters; "volume" when nothing is left.

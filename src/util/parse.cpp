@@ -66,6 +66,42 @@ void parseSize(std::string_view text, const std::string& what, int maxSide, int&
     height = static_cast<int>(parseInt(text.substr(x + 1), what + " height", 1, maxSide));
 }
 
+std::vector<std::string> splitList(const std::string& text, const std::string& flag) {
+    std::vector<std::string> items;
+    size_t start = 0;
+    while (true) {
+        const size_t comma = text.find(',', start);
+        std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        const size_t b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
+        item = b == std::string::npos ? "" : item.substr(b, e - b + 1);
+        if (item.empty()) throw Error(flag + ": empty item in '" + text + "' (expected a comma-separated list)");
+        items.push_back(item);
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    return items;
+}
+
+size_t jsonNestingPastLimit(std::string_view text, int limit) {
+    int depth = 0;
+    bool inString = false, escaped = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (escaped) escaped = false;
+            else if (c == '\\') escaped = true;
+            else if (c == '"') inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > limit) return i;
+        } else if (c == ']' || c == '}') {
+            depth = depth > 0 ? depth - 1 : 0;
+        }
+    }
+    return std::string::npos;
+}
+
 std::string printable(std::string_view text, size_t maxChars) {
     std::string out;
     for (char c : text.substr(0, maxChars)) out += (c >= 0x20 && c < 0x7f) ? c : '?';

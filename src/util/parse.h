@@ -25,6 +25,15 @@ std::vector<double> parseDoubleList(std::string_view text, const std::string& wh
 /// @throw Error naming @p what when malformed or out of range.
 void parseSize(std::string_view text, const std::string& what, int maxSide, int& width, int& height);
 
+/// @brief Splits "a,b,c" into items trimmed of spaces and tabs.
+/// @throw Error "<flag>: empty item in '<text>' …" for an empty list or an empty item.
+std::vector<std::string> splitList(const std::string& text, const std::string& flag);
+
+/// @brief The byte offset at which JSON @p text first nests deeper than @p limit levels of [ and {
+/// (brackets inside strings do not count), or std::string::npos. Checked before parsing: a file
+/// of 100 000 '[' would otherwise exhaust the stack of a recursive parser.
+size_t jsonNestingPastLimit(std::string_view text, int limit);
+
 /// @brief @p text for an error message: bytes other than printable ASCII become '?' (a file's
 /// header cannot send terminal escapes), cut to @p maxChars with "..." after.
 std::string printable(std::string_view text, size_t maxChars = 60);

@@ -178,22 +178,43 @@ int VoxelStream::lodLevel(const Block& b) const {
     return level;
 }
 
+namespace {
+/// A voxel's classification as every stream path computes it: the baked table's, then shaded
+/// (VoxelShader, the same factors the reference reads) when shading is on, then the emission
+/// grid's term added (after shading: emitted light is not lit; docs/emission.md). One per block:
+/// it holds the tree accessors, and blocks run on any thread.
+class VoxelClassifier {
+public:
+    VoxelClassifier(const Volume& volume, const ClassificationTable& table, const VoxelShader* shader,
+                    const EmissionSource* emission)
+        : table_(table), shader_(shader), emission_(emission) {
+        if (shader_) shaderAcc_.emplace(volume.grid->tree());
+        if (emission_) emissionAcc_.emplace(emission_->accessor());
+    }
+    Classified operator()(const openvdb::FloatTree::LeafNodeType* leaf, openvdb::Index n, const openvdb::Coord& ijk,
+                          float value) {
+        Classified cls = table_(value);
+        if (shader_ && cls.sigma > 0.f) cls = applyShading(cls, (*shader_)(*shaderAcc_, leaf, n, ijk, value));
+        return emission_ ? applyEmission(cls, emission_->at(*emissionAcc_, ijk)) : cls;
+    }
+
+private:
+    const ClassificationTable& table_;
+    const VoxelShader* shader_;
+    const EmissionSource* emission_;
+    std::optional<VoxelShader::Accessor> shaderAcc_;
+    std::optional<EmissionSource::Accessor> emissionAcc_;
+};
+}  // namespace
+
 /// Calls fn(local index (0..dim−1 per axis), classification) for every active voxel of the
 /// block: the table's, then shaded (VoxelShader, the same factors the reference reads) when
 /// shading is on. Shading here, in the parallel extraction, costs only the voxels drawn.
 template <typename Fn>
 void VoxelStream::forEachActive(const Block& b, Fn&& fn) const {
-    std::optional<VoxelShader::Accessor> acc;
-    if (shader_) acc.emplace(volume_.grid->tree());  // per block: blocks run on any thread
-    std::optional<EmissionSource::Accessor> emissionAcc;
-    if (emission_) emissionAcc.emplace(emission_->accessor());
+    VoxelClassifier classifyAt(volume_, table_, shader_, emission_);  // per block: blocks run on any thread
     const auto classify = [&](openvdb::Index n, float value) {
-        Classified cls = table_(value);
-        if (!shader_ && !emission_) return cls;
-        const openvdb::Coord ijk = b.origin.offsetBy(int(n >> 6), int((n >> 3) & 7), int(n & 7));
-        if (shader_ && cls.sigma > 0.f) cls = applyShading(cls, (*shader_)(*acc, b.leaf, n, ijk, value));
-        // Emission after shading: emitted light is not lit (docs/emission.md).
-        return emission_ ? applyEmission(cls, emission_->at(*emissionAcc, ijk)) : cls;
+        return classifyAt(b.leaf, n, b.origin.offsetBy(int(n >> 6), int((n >> 3) & 7), int(n & 7)), value);
     };
     if (b.leaf) {
         const float* values = b.leaf->buffer().data();
@@ -236,10 +257,7 @@ template <typename Fn>
 void forEachRow(const auto& b, const Volume& volume, const ClassificationTable& table, const VoxelShader* shader,
                 const EmissionSource* emission, Fn&& fn) {
     constexpr int kDim = kBlockDim;
-    std::optional<VoxelShader::Accessor> acc;
-    if (shader) acc.emplace(volume.grid->tree());  // per block: blocks run on any thread
-    std::optional<EmissionSource::Accessor> emissionAcc;
-    if (emission) emissionAcc.emplace(emission->accessor());
+    VoxelClassifier classify(volume, table, shader, emission);
     std::array<float, kDim> sigma;
     std::array<glm::vec3, kDim> color;
     const float* values = b.leaf ? b.leaf->buffer().data() : nullptr;
@@ -255,12 +273,7 @@ void forEachRow(const auto& b, const Volume& volume, const ClassificationTable& 
                     sigma[size_t(z)] = 0.f, color[size_t(z)] = glm::vec3(0.f);
                     continue;
                 }
-                const float value = values ? values[n] : b.tileValue;
-                Classified cls = table(value);
-                if (shader && cls.sigma > 0.f)
-                    cls = applyShading(cls, (*shader)(*acc, b.leaf, n, b.origin.offsetBy(x, y, z), value));
-                // Emission after shading, as forEachActive (docs/emission.md).
-                if (emission) cls = applyEmission(cls, emission->at(*emissionAcc, b.origin.offsetBy(x, y, z)));
+                const Classified cls = classify(b.leaf, n, b.origin.offsetBy(x, y, z), values ? values[n] : b.tileValue);
                 sigma[size_t(z)] = cls.sigma, color[size_t(z)] = cls.color;
             }
             fn(x, y, sigma, color);

@@ -16,6 +16,7 @@
 
 #include "image/image.h"
 #include "util/error.h"
+#include "util/parse.h"
 
 namespace vdbsplat {
 
@@ -71,24 +72,10 @@ std::string positionOf(const std::string& text, size_t byte);
 /// '[' would otherwise exhaust the stack in the parser or in dump()). Strings are skipped,
 /// so brackets inside them do not count.
 void checkNesting(const std::string& text, const std::string& origin) {
-    int depth = 0;
-    bool inString = false, escaped = false;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (inString) {
-            if (escaped) escaped = false;
-            else if (c == '\\') escaped = true;
-            else if (c == '"') inString = false;
-        } else if (c == '"') {
-            inString = true;
-        } else if (c == '[' || c == '{') {
-            if (++depth > kMaxJsonDepth)
-                throw Error(fail(origin, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels at " +
-                                             positionOf(text, i + 1) + " (transfer functions need 3)"));
-        } else if (c == ']' || c == '}') {
-            depth = std::max(0, depth - 1);
-        }
-    }
+    const size_t at = jsonNestingPastLimit(text, kMaxJsonDepth);
+    if (at != std::string::npos)
+        throw Error(fail(origin, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels at " +
+                                     positionOf(text, at + 1) + " (transfer functions need 3)"));
 }
 
 // --- Piecewise-linear evaluation --------------------------------------------

@@ -34,22 +34,8 @@ using test::CliResult;
 using test::slurp;
 using test::spit;
 
-std::vector<std::string> lines(const std::string& text) {
-    std::vector<std::string> out;
-    std::istringstream s(text);
-    std::string l;
-    while (std::getline(s, l)) out.push_back(l);
-    return out;
-}
-
-std::vector<std::string> fields(const std::string& line) {
-    std::vector<std::string> out;
-    std::stringstream s(line);
-    std::string f;
-    while (std::getline(s, f, ',')) out.push_back(f);
-    if (!line.empty() && line.back() == ',') out.push_back("");
-    return out;
-}
+using test::fields;
+using test::lines;
 
 size_t countFiles(const fs::path& dir, const std::string& prefix) {
     size_t n = 0;

@@ -33,19 +33,8 @@ using test::CliResult;
 using test::slurp;
 using test::spit;
 
-std::vector<std::string> lines(const std::string& text) {
-    std::vector<std::string> out;
-    std::istringstream s(text);
-    for (std::string l; std::getline(s, l);) out.push_back(l);
-    return out;
-}
-
-std::vector<std::string> fields(const std::string& line) {
-    std::vector<std::string> out;
-    std::stringstream s(line);
-    for (std::string f; std::getline(s, f, ',');) out.push_back(f);
-    return out;
-}
+using test::fields;
+using test::lines;
 
 /// Column name → index of metrics.csv's header.
 std::map<std::string, size_t> columns(const std::string& header) {

@@ -12,6 +12,7 @@
 #include "study/report.h"
 #include "study/spec.h"
 #include "study/views.h"
+#include "util/parse.h"
 #include "support/error_of.h"
 #include "util/error.h"
 

@@ -28,6 +28,23 @@ namespace vdbsplat::test {
 namespace fs = std::filesystem;
 
 /// @brief The whole content of @p p ("" when it cannot be read).
+/// The lines of @p text, without their newlines.
+inline std::vector<std::string> lines(const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream s(text);
+    for (std::string l; std::getline(s, l);) out.push_back(l);
+    return out;
+}
+
+/// The comma-separated fields of one CSV line (no quoting), a trailing empty field included.
+inline std::vector<std::string> fields(const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream s(line);
+    for (std::string f; std::getline(s, f, ',');) out.push_back(f);
+    if (!line.empty() && line.back() == ',') out.push_back("");
+    return out;
+}
+
 inline std::string slurp(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     std::ostringstream s;
