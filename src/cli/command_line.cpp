@@ -2,7 +2,6 @@
 #include "cli/command_line.h"
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <memory>
 #include <sstream>
 
@@ -45,7 +44,12 @@ public:
     }
 };
 
-/// The app that was being parsed when @p e came: the chosen command, else @p top.
+/// Whether @p top is vdbsplat's app with its commands and none was chosen yet.
+bool awaitingCommand(const CLI::App& top) {
+    return top.get_require_subcommand_min() > 0 && top.get_subcommands().empty();
+}
+
+/// The app that was being parsed when the error came: the chosen command, else @p top.
 const CLI::App& commandOf(const CLI::App& top) {
     const auto chosen = top.get_subcommands();
     return chosen.empty() ? top : *chosen.front();
@@ -71,7 +75,7 @@ std::string unexpected(const CLI::App& top, const CLI::App& command) {
     std::string arg = left.front();
     const bool option = arg.size() > 1 && arg[0] == '-';
     if (option && arg.rfind("--", 0) == 0) arg = arg.substr(0, arg.find('='));
-    if (&command == &top && top.get_subcommands().empty() && !top.get_name().empty() && !option)
+    if (awaitingCommand(top) && !option)
         return "unknown command '" + printable(arg) + "' (try: " + top.get_name() + " --help)";
     return (option ? "unknown option '" : "unexpected argument '") + printable(arg) + "' (see --help)";
 }
@@ -107,7 +111,7 @@ std::string parseErrorMessage(const CLI::App& top, const CLI::ParseError& e) {
     const std::string what = e.what();
     if (dynamic_cast<const CLI::ExtrasError*>(&e)) return unexpected(top, command);
     if (dynamic_cast<const CLI::RequiredError*>(&e)) {
-        if (&command == &top && top.get_subcommands().empty() && !top.get_parent() && top.get_require_subcommand_min() > 0)
+        if (awaitingCommand(top))
             return top.remaining(true).empty() ? "no command given (try: " + top.get_name() + " --help)"
                                                : unexpected(top, command);
         return what + " (see --help)";
@@ -120,9 +124,23 @@ std::string parseErrorMessage(const CLI::App& top, const CLI::ParseError& e) {
     return flag.empty() ? what : flag + what.substr(flag.size());
 }
 
+void parseWords(CLI::App& app, const Argv& words) {
+    Argv reversed;  // CLI11 takes the words last to first
+    for (auto w = words.rbegin(); w != words.rend(); ++w) {
+        // "--flag=" is an empty value; CLI11 would take the next word as the value instead.
+        if (w->size() > 3 && w->rfind("--", 0) == 0 && w->find('=') == w->size() - 1) {
+            reversed.push_back("");
+            reversed.push_back(w->substr(0, w->size() - 1));
+        } else {
+            reversed.push_back(*w);
+        }
+    }
+    app.parse(reversed);
+}
+
 Args parseAlone(CLI::App& app, const Argv& argv) {
     try {
-        app.parse(Argv(argv.rbegin(), argv.rend()));  // CLI11 takes the words last to first
+        parseWords(app, argv);
     } catch (const CLI::ParseError& e) {
         throw Error(parseErrorMessage(app, e));
     }

@@ -41,6 +41,10 @@ void useHelpLayout(CLI::App& app);
 /// called on): it names the unknown option, the flag missing its value, or the unknown command.
 std::string parseErrorMessage(const CLI::App& top, const CLI::ParseError& e);
 
+/// @brief Parses @p words (the command line without the program name) with @p app: app.parse
+/// with "--flag=" read as the empty value it is. @throw CLI::ParseError as app.parse does.
+void parseWords(CLI::App& app, const Argv& words);
+
 /// @brief Parses @p argv (the arguments after the command name) with @p app, a command
 /// declared on its own (not a subcommand). @throw Error with parseErrorMessage for a bad
 /// command line, and Error "--help: not here" when it asks for help.

@@ -57,7 +57,7 @@ std::string oneLine(const std::string& message) {
 /// Parses the command line and runs the command it names; help and version exit 0.
 int parseAndRun(CLI::App& app, int argc, char** argv) {
     try {
-        app.parse(argc, argv);
+        parseWords(app, std::vector<std::string>(argv + 1, argv + argc));
     } catch (const CLI::CallForHelp&) {
         std::cout << app.help();  // the chosen command's help, or the list of commands
         return 0;

@@ -171,7 +171,6 @@ TEST_F(CliFlags, SharedFlagsAreParsedAlike) {
         {"--filter-order sideways", "--filter-order"},
         {"--footprint fast", "--footprint"},
         {"--simd maybe", "--simd"},
-        {"--kernel box", "--kernel"},
         {"--up 0,0", "--up"},
         {"--view-dir 1,x,0", "--view-dir"},
         {"--shading glossy", "--shading"},
