@@ -176,16 +176,6 @@ void addRenderFlags(CLI::App& app, const std::set<std::string>& leaveOut) {
     }
 }
 
-const std::set<std::string>& renderValueFlags() {
-    static const std::set<std::string> flags = [] {
-        std::set<std::string> names;
-        for (const RenderFlag& f : kRenderFlags)
-            if (f.value) names.insert(f.name);
-        return names;
-    }();
-    return flags;
-}
-
 glm::dvec3 parseVec3(const std::string& text, const std::string& flag) {
     const auto v = parseDoubleList(text, flag, 3);
     return {v[0], v[1], v[2]};

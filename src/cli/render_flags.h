@@ -25,9 +25,6 @@ namespace vdbsplat::cli {
 /// command sets itself: animate's path places the camera, the study varies the mode, …).
 void addRenderFlags(CLI::App& app, const std::set<std::string>& leaveOut = {});
 
-/// The render flags that take a value (every one but --show-primitives).
-const std::set<std::string>& renderValueFlags();
-
 /// @brief "X,Y,Z" → vector; @throw Error naming @p flag.
 glm::dvec3 parseVec3(const std::string& text, const std::string& flag);
 
