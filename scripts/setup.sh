@@ -6,7 +6,7 @@ set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config git
       libopenvdb-dev libboost-iostreams-dev libopenexr-dev libglm-dev libtbb-dev
       libgtest-dev libbenchmark-dev nlohmann-json3-dev zlib1g-dev libhwy-dev
-      libpng-dev libpugixml-dev clang)  # clang: the sanitizer and libFuzzer build (scripts/sanitize.sh, scripts/fuzz.sh)
+      libpng-dev libpugixml-dev libcli11-dev clang)  # clang: the sanitizer and libFuzzer build (scripts/sanitize.sh, scripts/fuzz.sh)
 # Test-only packages: the build never needs them, and chromium (about 100 MB with its libraries)
 # would slow every quick start. Without it the study report's end-to-end test skips itself.
 TEST_PKGS=(chromium)  # headless check of `vdbsplat study`'s index.html (tests/cli/test_cli_study.cpp)

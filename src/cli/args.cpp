@@ -1,33 +1,33 @@
-// cli/args.cpp — strict flag parsing (see args.h).
+// cli/args.cpp — a parsed CLI::App read back by flag name (see args.h).
 #include "cli/args.h"
 
+#include <CLI/App.hpp>
+
 #include "util/error.h"
+#include "util/parse.h"
 
 namespace vdbsplat::cli {
 
-Args::Args(const std::vector<std::string>& argv, const std::set<std::string>& valueFlags,
-           const std::set<std::string>& switches) {
-    for (size_t i = 0; i < argv.size(); ++i) {
-        std::string arg = argv[i];
-        if (arg == "--help" || arg == "-h") { help_ = true; continue; }
-        if (arg.size() < 2 || arg[0] != '-' || (arg[1] >= '0' && arg[1] <= '9') || arg[1] == '.') {
-            positionals_.push_back(arg);
-            continue;
-        }
-        std::optional<std::string> inlineValue;
-        if (const size_t eq = arg.find('='); arg.rfind("--", 0) == 0 && eq != std::string::npos) {
-            inlineValue = arg.substr(eq + 1);
-            arg = arg.substr(0, eq);
-        }
-        if (valueFlags.count(arg)) {
-            if (values_.count(arg)) throw Error(arg + ": given more than once");
-            if (inlineValue) { values_[arg] = *inlineValue; continue; }
-            if (i + 1 >= argv.size()) throw Error(arg + ": missing value");
-            values_[arg] = argv[++i];
-        } else if (switches.count(arg) && !inlineValue) {
-            switches_.insert(arg);
+namespace {
+
+bool isSwitch(const CLI::Option& o) { return o.get_expected_max() == 0; }
+
+}  // namespace
+
+Args::Args(const CLI::App& app, std::vector<std::string> words) : words_(std::move(words)) {
+    for (const CLI::Option* o : app.get_options()) {
+        if (o->count() == 0 || o == app.get_help_ptr()) continue;
+        const std::string name = o->get_name();
+        const CLI::results_t& given = o->results();
+        if (o->get_positional()) {
+            positionals_.insert(positionals_.end(), given.begin(), given.end());
+        } else if (isSwitch(*o)) {
+            for (const std::string& v : given)
+                if (v != "true") throw Error(name + ": takes no value, got '" + printable(v) + "'");
+            switches_.insert(name);
         } else {
-            throw Error("unknown option '" + arg + "' (see --help)");
+            if (given.size() > 1) throw Error(name + ": given more than once");
+            values_[name] = given.front();
         }
     }
 }
@@ -49,9 +49,9 @@ std::string Args::require(const std::string& flag) const {
 }
 
 std::string Args::onePositional(const std::string& what) const {
-    if (positionals_.size() != 1)
-        throw Error(positionals_.empty() ? "missing " + what + " (see --help)"
-                                         : "expected one " + what + ", got " + std::to_string(positionals_.size()));
+    if (positionals_.empty()) throw Error("missing " + what + " (see --help)");
+    if (positionals_.size() > 1)
+        throw Error("expected one " + what + ", got " + std::to_string(positionals_.size()));
     return positionals_.front();
 }
 

@@ -1,7 +1,8 @@
-// cli/args.h — a small strict command-line parser shared by every subcommand.
-// Owns: splitting "--flag value" / "--flag=value" / "-o value" / switches /
-// positionals, rejecting unknown or repeated flags and missing values with a
-// one-line Error that names the flag.
+// cli/args.h — what CLI11 parsed for one command, by flag name.
+// Owns: reading a parsed CLI::App back into flag → value, switches and positionals (the
+// commands look their flags up by the name they were declared with, command_line.h), and
+// the checks CLI11 leaves to us: a value flag given twice and a switch given a value are
+// errors that name the flag.
 #pragma once
 #include <map>
 #include <optional>
@@ -9,15 +10,19 @@
 #include <string>
 #include <vector>
 
+namespace CLI {
+class App;
+}
+
 namespace vdbsplat::cli {
 
 class Args {
 public:
-    /// @param valueFlags flags that take a value (e.g. "--size", "-o")
-    /// @param switches   flags without a value (e.g. "-v", "--show-primitives")
-    /// @throw Error for an unknown flag, a repeated flag, or a flag missing its value.
-    Args(const std::vector<std::string>& argv, const std::set<std::string>& valueFlags,
-         const std::set<std::string>& switches);
+    Args() = default;
+    /// @brief The flags and positionals @p app parsed (an app after a successful parse());
+    /// @p words: the command line after the command name, as given (for a record of it).
+    /// @throw Error for a value flag given more than once or a switch given a value.
+    explicit Args(const CLI::App& app, std::vector<std::string> words = {});
 
     bool has(const std::string& flag) const { return values_.count(flag) || switches_.count(flag); }
     std::optional<std::string> get(const std::string& flag) const;
@@ -25,15 +30,21 @@ public:
     /// @throw Error "<flag> is required" when absent.
     std::string require(const std::string& flag) const;
     const std::vector<std::string>& positionals() const { return positionals_; }
-    /// @brief The single positional argument; @throw Error naming @p what when there is not exactly one.
+    /// The command line after the command name, as given.
+    const std::vector<std::string>& words() const { return words_; }
+    /// @brief The single positional argument; @throw Error naming @p what when there is none.
     std::string onePositional(const std::string& what) const;
-    bool wantsHelp() const { return help_; }
+
+    /// @brief Gives value flag @p flag the value @p value (replacing any), as if it had been parsed.
+    void set(const std::string& flag, const std::string& value) { values_[flag] = value; }
+    /// @brief Gives switch @p flag, as if it had been parsed.
+    void setSwitch(const std::string& flag) { switches_.insert(flag); }
 
 private:
     std::map<std::string, std::string> values_;
     std::set<std::string> switches_;
     std::vector<std::string> positionals_;
-    bool help_ = false;
+    std::vector<std::string> words_;
 };
 
 }  // namespace vdbsplat::cli

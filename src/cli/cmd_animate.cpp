@@ -1,11 +1,12 @@
 // cli/cmd_animate.cpp — `vdbsplat animate`: load the grid once, render a camera path to frames.
-// Owns: the animate flags (the render flags through render_flags.h), the output folder
+// Owns: the animate flags (declared here; the render flags through render_flags.h), the output folder
 // protocol (refuse a non-empty folder without --resume/--force; animation.json and
 // reference/reference.json record what the frames were made with, so --resume never mixes
 // two animations), the frame loop (render() per frame, atomic frames, frames.csv kept
 // consistent while running: rewritten at most once a second and at the end or on an
 // interruption), the Ctrl-C/SIGTERM flag checked between frames, the progress bar, the plot
 // and the optional MP4. The path maths, flicker, CSV rows and plot are in animation/.
+#include <CLI/App.hpp>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -31,7 +32,7 @@
 
 #include "animation/camera_path.h"
 #include "animation/frame_stats.h"
-#include "cli/args.h"
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/interrupt.h"
 #include "cli/render_flags.h"
@@ -51,58 +52,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using animation::FrameRecord;
-
-const char* kHelp =
-    "usage: vdbsplat animate FILE.vdb -o DIR (--from K --to K | --orbit DEG | --path FILE.json) [options]\n"
-    "\n"
-    "Loads the grid once and renders a camera path into DIR as frame_0000.png, frame_0001.png, …\n"
-    "(each written atomically), with per-frame statistics in DIR/frames.csv.\n"
-    "\n"
-    "path (exactly one):\n"
-    "  --from K --to K    zoom: framing distances (as --distance: 8 far, 1 framed, 0.125 close) from K\n"
-    "                     to K, spaced geometrically (the same zoom factor between any two frames)\n"
-    "  --orbit DEG        orbit: the eye at --distance turns DEG degrees about the up axis through the\n"
-    "                     centre of the grid's bounds; frame i at DEG*i/N (so 360 loops seamlessly)\n"
-    "  --path FILE.json   keyframes: [{\"eye\": [x,y,z], \"look_at\": [x,y,z], \"up\": [x,y,z], \"fov\": DEG,\n"
-    "                     \"time\": S}, …] (up and fov optional: --up, --fov), times increasing;\n"
-    "                     Catmull-Rom spline on eye, look-at and up, monotone cubic on fov\n"
-    "  --frames N         frames, 1..100000 (required for zoom and orbit; --path: or --fps)\n"
-    "  --fps F            --path without --frames: sample the keyframes at F frames per second;\n"
-    "                     also the MP4's frame rate (default 24)\n"
-    "\n"
-    "output:\n"
-    "  -o DIR             output folder (created; its parent must exist). A non-empty DIR is refused\n"
-    "                     unless --resume or --force is given\n"
-    "  --format F         png (default; 8-bit sRGB over black) | exr (float linear RGBA)\n"
-    "  --resume           keep frames already in DIR (readable, the right size, with their row in\n"
-    "                     frames.csv) and render the rest; refused if DIR was made with other settings\n"
-    "  --force            start afresh in a non-empty DIR (removes its frames, frames.csv, plot.svg,\n"
-    "                     animation.json, animation.mp4 and reference/)\n"
-    "  --reference        also render reference frames (mode reference, --spp; cached as EXR in\n"
-    "                     DIR/reference/, reused by --resume) and add to frames.csv the PSNR of each\n"
-    "                     frame and its flicker F_t = mean |(I_t - I_t-1) - (R_t - R_t-1)| over pixels\n"
-    "                     and RGB of display values; writes DIR/plot.svg (PSNR, flicker, splat fraction,\n"
-    "                     and the frames where the splat fraction crosses 50% or steps by > 10 points)\n"
-    "  --mp4              also encode DIR/animation.mp4 with ffmpeg when it is on PATH (else a note)\n"
-    "\n"
-    "render flags (as vdbsplat render):\n"
-    VDBSPLAT_SCENE_FLAGS_HELP
-    "  --up X,Y,Z         up vector (default 0,0,1); zoom and orbit: also the orbit axis\n"
-    "  --view-dir X,Y,Z   zoom and orbit: framing direction, centre to eye (default 0.9,-1.3,0.75)\n"
-    "  --fov DEG          vertical field of view (default 30; --path: for keys without fov)\n"
-    "  --distance K       orbit: framing distance (default 1)\n"
-    "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
-    "  --lod PX           level-of-detail cell size in pixels (default 1.25; 0: off; see render --help)\n"
-    "  --simd on|off      splats through the vector loop (default on) or the scalar table path\n"
-    "  --footprint P      auto (default) | table | exact (see render --help)\n"
-    "  --filter-order O   postfilter (default) | prefilter; --subpixels K (see render --help)\n"
-    "  --show-primitives  tint splats red\n"
-    "  --tables DIR       footprint and reindex tables (see render --help)\n"
-    "  --spp N            reference rays per pixel (default 16, rounded up to a square)\n"
-    "  --threads N        worker threads (default: all cores)\n"
-    "\n"
-    "Ctrl-C or SIGTERM stops after the frame being rendered (a second one stops at once):\n"
-    "finished frames and frames.csv stay consistent, exit 1. Prints a summary line on stdout.\n";
 
 // ---- the path -----------------------------------------------------------------------------
 
@@ -368,17 +317,64 @@ void encodeMp4(const std::string& ffmpeg, const fs::path& dir, size_t count, con
 
 }  // namespace
 
-int runAnimate(const Argv& argv) {
-    std::set<std::string> valueFlags = renderValueFlags();
-    valueFlags.erase("--eye");  // the path places the camera
-    valueFlags.erase("--look-at");
-    valueFlags.insert({"-o", "--from", "--to", "--frames", "--orbit", "--path", "--fps", "--format"});
-    const Args args(argv, valueFlags, {"--show-primitives", "--resume", "--force", "--reference", "--mp4"});
-    if (args.wantsHelp()) {
-        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp << "\nemission (docs/emission.md):\n"
-                  << kEmissionHelp;
-        return 0;
-    }
+void declareAnimate(CLI::App& app) {
+    app.description(
+        "render a camera path (zoom, orbit, keyframes) to frames, with per-frame stats\n"
+        "\n"
+        "usage: vdbsplat animate FILE.vdb -o DIR (--from K --to K | --orbit DEG | --path FILE.json) [options]\n"
+        "\n"
+        "Loads the grid once and renders a camera path into DIR as frame_0000.png, frame_0001.png, …\n"
+        "(each written atomically), with per-frame statistics in DIR/frames.csv.");
+    addPositional(app, "FILE.vdb", "the volume to render");
+    const std::string path = "path (exactly one of zoom, orbit, keyframes)", output = "output";
+    addValueFlag(app, "--from", "K", "zoom: framing distance of the first frame (as --distance: 8 far, 1\n"
+                                     "framed, 0.125 close); with --to")
+        ->group(path);
+    addValueFlag(app, "--to", "K", "zoom: framing distance of the last frame; the distances between are\n"
+                                   "spaced geometrically (the same zoom factor between any two frames)")
+        ->group(path);
+    addValueFlag(app, "--orbit", "DEG", "orbit: the eye at --distance turns DEG degrees about the up axis\n"
+                                        "through the centre of the grid's bounds; frame i at DEG*i/N (so 360\n"
+                                        "loops seamlessly)")
+        ->group(path);
+    addValueFlag(app, "--path", "FILE.json", "keyframes: [{\"eye\": [x,y,z], \"look_at\": [x,y,z], \"up\": [x,y,z],\n"
+                                             "\"fov\": DEG, \"time\": S}, …] (up and fov optional: --up, --fov),\n"
+                                             "times increasing; Catmull-Rom spline on eye, look-at and up,\n"
+                                             "monotone cubic on fov")
+        ->group(path);
+    addValueFlag(app, "--frames", "N", "frames, 1..100000 (required for zoom and orbit; --path: or --fps)")->group(path);
+    addValueFlag(app, "--fps", "F", "--path without --frames: sample the keyframes at F frames per second;\n"
+                                    "also the MP4's frame rate (default 24)")
+        ->group(path);
+    addValueFlag(app, "-o", "DIR", "output folder (created; its parent must exist). A non-empty DIR is\n"
+                                   "refused unless --resume or --force is given")
+        ->required()
+        ->group(output);
+    addValueFlag(app, "--format", "F", "png (default; 8-bit sRGB over black) | exr (float linear RGBA)")->group(output);
+    addSwitch(app, "--resume", "keep frames already in DIR (readable, the right size, with their row in\n"
+                               "frames.csv) and render the rest; refused if DIR was made with other\n"
+                               "settings")
+        ->group(output);
+    addSwitch(app, "--force", "start afresh in a non-empty DIR (removes its frames, frames.csv,\n"
+                              "plot.svg, animation.json, animation.mp4 and reference/)")
+        ->group(output);
+    addSwitch(app, "--reference", "also render reference frames (mode reference, --spp; cached as EXR in\n"
+                                  "DIR/reference/, reused by --resume) and add to frames.csv the PSNR of\n"
+                                  "each frame and its flicker F_t = mean |(I_t - I_t-1) - (R_t - R_t-1)|\n"
+                                  "over pixels and RGB of display values; writes DIR/plot.svg (PSNR,\n"
+                                  "flicker, splat fraction, and the frames where the splat fraction\n"
+                                  "crosses 50% or steps by > 10 points)")
+        ->group(output);
+    addSwitch(app, "--mp4", "also encode DIR/animation.mp4 with ffmpeg when it is on PATH (else a\n"
+                            "note)")
+        ->group(output);
+    addRenderFlags(app, {"--eye", "--look-at"});  // the path places the camera
+    app.footer(
+        "Ctrl-C or SIGTERM stops after the frame being rendered (a second one stops at once):\n"
+        "finished frames and frames.csv stay consistent, exit 1. Prints a summary line on stdout.");
+}
+
+int runAnimate(const Args& args) {
     Options o = optionsFrom(args);
     const fs::path dir(o.dir);
     std::error_code ec;

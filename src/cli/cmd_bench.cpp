@@ -7,6 +7,7 @@
 // ratios over distances), the fixed-width table in the manner of Yuan et al. 2003,
 // Figure 9, and the optional JSON report (written atomically). It is a benchmark,
 // not a test: nothing here judges the numbers.
+#include <CLI/App.hpp>
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
@@ -23,8 +24,7 @@
 #include <thread>
 #include <vector>
 
-#include "footprint/kernel.h"
-#include "cli/args.h"
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/render_flags.h"
 #include "volume/emission.h"
@@ -37,35 +37,10 @@ namespace vdbsplat::cli {
 
 namespace {
 
-const char* kHelp =
-    "usage: vdbsplat bench FILE.vdb [options]\n"
-    "\n"
-    "Renders FILE at the standard views (--distance 8 far, 1 framed, 0.35 close) in hybrid,\n"
-    "splat-only and point-only mode, several runs each, and prints, per view and mode, the\n"
-    "median and minimum seconds of render() (as `vdbsplat render -v` reports it), the share of\n"
-    "splats among drawn primitives, and the ratio of the mode's median to hybrid's at that view;\n"
-    "then the median of those ratios over the views. Runs are interleaved (for each run: for\n"
-    "each view: for each mode) so machine drift affects every mode alike. A benchmark, not a test.\n"
-    "\n"
-    "  --grid NAME          grid to render (default: the grid named density, else the first float or double grid)\n"
-    "  --tf PRESET|FILE     transfer function: grey (default), ct-bone, fire, or a JSON file\n"
-    "  --size WxH           image size in pixels (default 400x400)\n"
-    "  --runs N             timed runs per view and mode, 1..1000 (default 5)\n"
-    "  --warmup N           untimed rounds before them, 0..100 (default 1)\n"
-    "  --threads N          worker threads (default: all cores)\n"
-    "  --modes LIST         comma-separated, from hybrid, splat, point, ewa, swan, none, reference\n"
-    "  --kernel K           gaussian (default) | gaussian-sharp, as for render\n"
-    "                       (default hybrid,splat,point; reference is slow)\n"
-    "  --distances LIST     comma-separated framing distances (default 8,1,0.35)\n"
-    "  --view-dir X,Y,Z     framing direction, centre to eye (default 0.9,-1.3,0.75)\n"
-    "  --up X,Y,Z           up vector (default 0,0,1)\n"
-    "  --threshold PX       minification threshold of hybrid mode in pixels (default 1)\n"
-    "  --lod PX             level-of-detail cell size in pixels (default 1.25; 0: off; see render --help)\n"
-    "  --simd on|off        vector splat loop (default on) or the scalar table path\n"
-    "  --footprint P        auto (default) | table | exact (see render --help)\n"
-    "  --filter-order O     postfilter (default) | prefilter; --subpixels K (see render --help)\n"
-    "  --json FILE.json     also write every run, the per-stage medians and the ratios as JSON\n"
-    "  -v                   print each run to stderr and the per-stage medians to stdout\n";
+/// Render flags bench does not take: it varies the mode and the distance itself (--modes,
+/// --distances), always frames the grid, and never renders the reference by default.
+const std::set<std::string> kNotBenchFlags{"--mode", "--distance", "--eye", "--look-at", "--fov",
+                                           "--spp", "--tables", "--max-voxels", "--show-primitives"};
 
 constexpr int kMaxRuns = 1000;
 constexpr int kMaxWarmup = 100;
@@ -122,31 +97,7 @@ struct Options {
 Options optionsFrom(const Args& args) {
     Options o;
     o.input = args.onePositional("input .vdb file");
-    RenderSettings& s = o.base;
-    if (auto v = args.get("--size")) parseSize(*v, "--size", 16384, s.camera.width, s.camera.height);
-    if (auto v = args.get("--tf")) s.transferFunction = *v;
-    if (auto v = args.get("--grid")) s.gridName = *v;
-    if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
-    if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
-    if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);
-    applyFilterFlags(args, s);
-    if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
-    if (auto v = args.get("--simd")) {
-        if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
-        s.simd = *v == "on";
-    }
-    if (auto v = args.get("--view-dir")) {
-        const auto d = parseDoubleList(*v, "--view-dir", 3);
-        s.camera.hasViewDir = true;
-        s.camera.viewDir = {d[0], d[1], d[2]};
-    }
-    if (auto v = args.get("--up")) {
-        const auto u = parseDoubleList(*v, "--up", 3);
-        s.camera.up = {u[0], u[1], u[2]};
-    }
-    s.shading = shadingFromFlags(args);
-    s.emission = emissionFromFlags(args);
-    if (auto v = args.get("--kernel")) s.kernel = KernelShape::named(*v).id();
+    o.base = settingsFromFlags(args);  // the render flags bench declares (kNotBenchFlags aside)
     if (auto v = args.get("--runs")) o.runs = int(parseInt(*v, "--runs", 1, kMaxRuns));
     if (auto v = args.get("--warmup")) o.warmup = int(parseInt(*v, "--warmup", 0, kMaxWarmup));
     if (auto v = args.get("--modes")) o.modes = parseModes(*v);
@@ -202,18 +153,31 @@ std::string formatDistance(double d) {
 
 }  // namespace
 
-int runBench(const Argv& argv) {
-    std::set<std::string> valueFlags{"--grid",      "--tf",  "--size", "--runs",      "--warmup", "--threads",
-                                     "--modes",     "--distances", "--threshold", "--lod", "--simd",
-                                     "--footprint", "--filter-order", "--subpixels", "--kernel", "--json", "--view-dir", "--up"};
-    valueFlags.insert(shadingValueFlags().begin(), shadingValueFlags().end());
-    valueFlags.insert(emissionValueFlags().begin(), emissionValueFlags().end());
-    const Args args(argv, valueFlags, {"-v"});
-    if (args.wantsHelp()) {
-        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp << "\nemission (docs/emission.md):\n"
-                  << kEmissionHelp;
-        return 0;
-    }
+void declareBench(CLI::App& app) {
+    app.description(
+        "time hybrid, splat-only and point-only at the standard views\n"
+        "\n"
+        "usage: vdbsplat bench FILE.vdb [options]\n"
+        "\n"
+        "Renders FILE at the standard views (--distance 8 far, 1 framed, 0.35 close) in hybrid,\n"
+        "splat-only and point-only mode, several runs each, and prints, per view and mode, the\n"
+        "median and minimum seconds of render() (as `vdbsplat render -v` reports it), the share of\n"
+        "splats among drawn primitives, and the ratio of the mode's median to hybrid's at that view;\n"
+        "then the median of those ratios over the views. Runs are interleaved (for each run: for\n"
+        "each view: for each mode) so machine drift affects every mode alike. A benchmark, not a test.");
+    addPositional(app, "FILE.vdb", "the volume to render");
+    addValueFlag(app, "--runs", "N", "timed runs per view and mode, 1..1000 (default 5)");
+    addValueFlag(app, "--warmup", "N", "untimed rounds before them, 0..100 (default 1)");
+    addValueFlag(app, "--modes", "LIST", "comma-separated, from hybrid, splat, point, ewa, swan, none,\n"
+                                         "reference (default hybrid,splat,point; reference is slow)");
+    addValueFlag(app, "--distances", "LIST", "comma-separated framing distances (default 8,1,0.35)");
+    addValueFlag(app, "--json", "FILE.json", "also write every run, the per-stage medians and the ratios as\n"
+                                             "JSON");
+    addSwitch(app, "-v", "print each run to stderr and the per-stage medians to stdout");
+    addRenderFlags(app, kNotBenchFlags);
+}
+
+int runBench(const Args& args) {
     const Options o = optionsFrom(args);
 
     std::unique_ptr<tbb::global_control> limit;

@@ -9,7 +9,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "cli/args.h"
+#include <CLI/App.hpp>
+
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "image/image.h"
 #include "metrics/metrics.h"
@@ -19,14 +21,6 @@
 namespace vdbsplat::cli {
 
 namespace {
-
-const char* kHelp =
-    "usage: vdbsplat compare IMAGE REFERENCE [--json FILE]\n"
-    "\n"
-    "Image metrics of IMAGE against REFERENCE (PNG or EXR, same size), on sRGB display\n"
-    "values in [0, 1] over black (alpha ignored): MSE, RMSE, PSNR (dB, peak 1; 'inf' when\n"
-    "identical), max abs error over R, G, B, and SSIM on luma (11x11 Gaussian window).\n"
-    "Prints one line; --json FILE also writes them as JSON (PSNR null when identical).\n";
 
 /// Reads an image, keeping any error on one line and naming the file.
 Image readChecked(const std::string& path) {
@@ -77,12 +71,22 @@ nlohmann::ordered_json report(const ImageMetrics& m, const Image& image, const s
 
 }  // namespace
 
-int runCompare(const Argv& argv) {
-    const Args args(argv, {"--json"}, {});
-    if (args.wantsHelp()) {
-        std::cout << kHelp;
-        return 0;
-    }
+void declareCompare(CLI::App& app) {
+    app.description(
+        "image metrics (PSNR, RMSE, SSIM) of an image against a reference\n"
+        "\n"
+        "usage: vdbsplat compare IMAGE REFERENCE [--json FILE]\n"
+        "\n"
+        "Image metrics of IMAGE against REFERENCE (PNG or EXR, same size), on sRGB display\n"
+        "values in [0, 1] over black (alpha ignored): MSE, RMSE, PSNR (dB, peak 1; 'inf' when\n"
+        "identical), max abs error over R, G, B, and SSIM on luma (11x11 Gaussian window).\n"
+        "Prints one line; --json FILE also writes them as JSON (PSNR null when identical).");
+    addPositional(app, "IMAGE", "the image to measure (PNG or EXR)");
+    addPositional(app, "REFERENCE", "the image it is measured against, of the same size");
+    addValueFlag(app, "--json", "FILE", "also write the metrics as JSON");
+}
+
+int runCompare(const Args& args) {
     const auto& pos = args.positionals();
     if (pos.size() != 2)
         throw Error("compare needs IMAGE and REFERENCE, got " + std::to_string(pos.size()) + " file(s) (see --help)");

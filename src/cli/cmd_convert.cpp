@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <iostream>
 
-#include "cli/args.h"
+#include <CLI/App.hpp>
+
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -21,31 +23,6 @@
 namespace vdbsplat::cli {
 
 namespace {
-
-const char* kHelp =
-    "usage: vdbsplat convert IN.raw[.gz] -o OUT.vdb --dims X,Y,Z --type T [--spacing SX,SY,SZ]\n"
-    "       vdbsplat convert IN.nrrd|IN.nhdr|IN.vti -o OUT.vdb [--array NAME]\n"
-    "                        [--threshold T] [--max-voxels N]\n"
-    "\n"
-    "Converts a volume into a sparse float grid named 'density'. The format is picked by the\n"
-    "extension: .nrrd / .nhdr (NRRD, encodings raw and gzip), .vti (VTK XML ImageData: ascii,\n"
-    "base64 or appended data, zlib-compressed or not), anything else is headerless raw (x fastest,\n"
-    "then y, then z; plain or gzip-compressed). Files are streamed, never read whole (except the\n"
-    "XML of a .vti with inline data). NRRD and VTI keep their spacing, origin and directions in\n"
-    "the grid's transform; `render` takes any voxel shape and affine transform.\n"
-    "\n"
-    "options:\n"
-    "  -o OUT.vdb            output file (written atomically)\n"
-    "  --dims X,Y,Z          raw only: voxel counts, each 1..65536; the file must hold exactly X*Y*Z voxels\n"
-    "  --type T              raw only: uint8 | int16 | uint16 | float32 | float64 (little-endian);\n"
-    "                        integers are normalised (/255, /32767, /65535), floats are kept\n"
-    "  --spacing SX,SY,SZ    raw only: voxel size along x, y, z in world units, each 1e-4..1e6\n"
-    "                        (default 1,1,1); anisotropic voxels (e.g. 1,1,2.5) render as ellipsoids\n"
-    "  --array NAME          .vti only: the PointData array to read (default: the active Scalars,\n"
-    "                        else the first one-component array)\n"
-    "  --threshold T         a voxel is active iff its normalised value is > T (default 0:\n"
-    "                        zeros are background); NaN/inf voxels stay inactive\n"
-    "  --max-voxels N        refuse volumes whose X*Y*Z exceeds N (default 2^26 = 67108864, at most 2^32)\n";
 
 enum class Format { Raw, Nrrd, Vti };
 
@@ -97,12 +74,38 @@ openvdb::FloatGrid::Ptr convert(const Args& args, const std::string& in, const C
 
 }  // namespace
 
-int runConvert(const Argv& argv) {
-    const Args args(argv, {"-o", "--dims", "--type", "--spacing", "--threshold", "--max-voxels", "--array"}, {});
-    if (args.wantsHelp()) {
-        std::cout << kHelp;
-        return 0;
-    }
+void declareConvert(CLI::App& app) {
+    app.description(
+        "turn a raw, NRRD or VTK ImageData volume into a sparse .vdb\n"
+        "\n"
+        "usage: vdbsplat convert IN.raw[.gz] -o OUT.vdb --dims X,Y,Z --type T [--spacing SX,SY,SZ]\n"
+        "       vdbsplat convert IN.nrrd|IN.nhdr|IN.vti -o OUT.vdb [--array NAME]\n"
+        "                        [--threshold T] [--max-voxels N]\n"
+        "\n"
+        "Converts a volume into a sparse float grid named 'density'. The format is picked by the\n"
+        "extension: .nrrd / .nhdr (NRRD, encodings raw and gzip), .vti (VTK XML ImageData: ascii,\n"
+        "base64 or appended data, zlib-compressed or not), anything else is headerless raw (x fastest,\n"
+        "then y, then z; plain or gzip-compressed). Files are streamed, never read whole (except the\n"
+        "XML of a .vti with inline data). NRRD and VTI keep their spacing, origin and directions in\n"
+        "the grid's transform; `render` takes any voxel shape and affine transform.");
+    addPositional(app, "IN", "the volume to convert: .raw[.gz], .nrrd, .nhdr or .vti");
+    addValueFlag(app, "-o", "OUT.vdb", "output file (written atomically)")->required();
+    addValueFlag(app, "--dims", "X,Y,Z", "raw only: voxel counts, each 1..65536; the file must hold exactly\n"
+                                         "X*Y*Z voxels");
+    addValueFlag(app, "--type", "T", "raw only: uint8 | int16 | uint16 | float32 | float64 (little-endian);\n"
+                                     "integers are normalised (/255, /32767, /65535), floats are kept");
+    addValueFlag(app, "--spacing", "SX,SY,SZ", "raw only: voxel size along x, y, z in world units, each\n"
+                                               "1e-4..1e6 (default 1,1,1); anisotropic voxels (e.g. 1,1,2.5)\n"
+                                               "render as ellipsoids");
+    addValueFlag(app, "--array", "NAME", ".vti only: the PointData array to read (default: the active\n"
+                                         "Scalars, else the first one-component array)");
+    addValueFlag(app, "--threshold", "T", "a voxel is active iff its normalised value is > T (default 0:\n"
+                                          "zeros are background); NaN/inf voxels stay inactive");
+    addValueFlag(app, "--max-voxels", "N", "refuse volumes whose X*Y*Z exceeds N (default 2^26 = 67108864,\n"
+                                           "at most 2^32)");
+}
+
+int runConvert(const Args& args) {
     const std::string in = args.onePositional("input file IN");
     const std::string out = args.require("-o");
     const ConvertOptions options = optionsFrom(args);

@@ -1,4 +1,5 @@
-// cli/cmd_render.cpp — `vdbsplat render`: flags → RenderSettings → render() → image (+ stats).
+// cli/cmd_render.cpp — `vdbsplat render`: its flags (the render flags, -o, --stats, -v), flags →
+// RenderSettings → render() → image (+ stats).
 // Everything is validated (flags, output path, volume, transfer function, camera)
 // before any rendering starts, and outputs are written atomically.
 #include <tbb/global_control.h>
@@ -7,9 +8,10 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <set>
 
-#include "cli/args.h"
+#include <CLI/App.hpp>
+
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/interrupt.h"
 #include "cli/render_flags.h"
@@ -22,47 +24,6 @@
 namespace vdbsplat::cli {
 
 namespace {
-
-const char* kHelp =
-    "usage: vdbsplat render FILE.vdb -o OUT.png|OUT.exr [options]\n"
-    "\n"
-    "  -o FILE            output image: .png (8-bit sRGB over black) or .exr (float linear RGBA + metadata)\n"
-    VDBSPLAT_SCENE_FLAGS_HELP
-    "  --eye X,Y,Z        camera position (world); default: frame the grid from a fixed oblique view\n"
-    "  --look-at X,Y,Z    point looked at (default: the centre of the grid's bounds)\n"
-    "  --up X,Y,Z         up vector (default 0,0,1)\n"
-    "  --view-dir X,Y,Z   without --eye: frame the grid from this direction (centre to eye;\n"
-    "                     default 0.9,-1.3,0.75)\n"
-    "  --fov DEG          vertical field of view (default 30)\n"
-    "  --distance K       multiplies the framing distance (8 far, 1 framed, 0.35 close)\n"
-    "  --threshold PX     minification threshold: voxels projecting under PX pixels are points (default 1)\n"
-    "  --lod PX           level of detail: points are merged into aggregates of 2^3, 4^3 or 8^3 voxels\n"
-    "                     (same total optical depth, centroid and spread) whose side projects to at\n"
-    "                     most PX pixels (default 1.25; 0 turns it off)\n"
-    "  --simd on|off      splats through the vector loop (default on) or the scalar table path\n"
-    "  --footprint P      auto (default): the (i, alpha) reindex table, and the exact ray-centre\n"
-    "                     distance for splats far off the axis where the affine index is off;\n"
-    "                     table: the reindex table for every splat; exact: closed form per pixel\n"
-    "  --filter-order O   where the pixel prefilter goes: postfilter (default): composite on a\n"
-    "                     grid with a small low-pass, then low-pass the composited image (right for\n"
-    "                     thin dense structures); prefilter: EWA's order, low-pass each primitive's\n"
-    "                     optical depth, then composite (too opaque for structures 1-2 px wide)\n"
-    "  --subpixels K      postfilter: composite on K x K sub-pixels per pixel, 1..8 (default 1;\n"
-    "                     2 is closer to the reference, at up to 3.5x the time at close views)\n"
-    "  --show-primitives  tint splats red, points keep their colour\n"
-    "  --tables DIR       footprint.table and reindex.table from DIR (default: the shipped tables/);\n"
-    "                     a file absent from DIR is built in memory, a corrupt one or one built for\n"
-    "                     another kernel is refused (the forward modes)\n"
-    "  --spp N            reference: rays per pixel (default 16, rounded up to a square)\n"
-    "  --max-voxels N     refuse grids with more than N active voxels, active tiles counted voxel\n"
-    "                     by voxel (default 2^30 = 1073741824, at most 2^32)\n"
-    "  --threads N        worker threads (default: all cores); the image does not depend on it\n"
-    "  --stats FILE.json  write settings, timings and primitive counts as JSON\n"
-    "  -v                 show progress on stderr (a bar with ETA on a terminal, a line per\n"
-    "                     10% otherwise) and print the statistics in one line at the end\n"
-    "\n"
-    "Ctrl-C or SIGTERM stops the render within a window (forward modes) or a row of rays\n"
-    "(reference): nothing is written, exit 1. A second one stops at once.\n";
 
 /// The stats file is written after the image: check its folder first, so a bad --stats
 /// path fails before any work and never leaves an image behind.
@@ -94,15 +55,25 @@ std::string oneLine(const RenderStats& st, const RenderSettings& s) {
 
 }  // namespace
 
-int runRender(const Argv& argv) {
-    std::set<std::string> valueFlags = renderValueFlags();
-    valueFlags.insert({"-o", "--stats"});
-    const Args args(argv, valueFlags, {"-v", "--show-primitives"});
-    if (args.wantsHelp()) {
-        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp << "\nemission (docs/emission.md):\n"
-                  << kEmissionHelp;
-        return 0;
-    }
+void declareRender(CLI::App& app) {
+    app.description(
+        "render a .vdb grid to PNG or EXR (reference, hybrid, splat, point, ewa, swan, none)\n"
+        "\n"
+        "usage: vdbsplat render FILE.vdb -o OUT.png|OUT.exr [options]");
+    addPositional(app, "FILE.vdb", "the volume to render");
+    addValueFlag(app, "-o", "FILE", "output image: .png (8-bit sRGB over black) or .exr (float linear\n"
+                                    "RGBA + metadata)")
+        ->required();
+    addValueFlag(app, "--stats", "FILE.json", "write settings, timings and primitive counts as JSON");
+    addSwitch(app, "-v", "show progress on stderr (a bar with ETA on a terminal, a line per\n"
+                         "10% otherwise) and print the statistics in one line at the end");
+    addRenderFlags(app);
+    app.footer(
+        "Ctrl-C or SIGTERM stops the render within a window (forward modes) or a row of rays\n"
+        "(reference): nothing is written, exit 1. A second one stops at once.");
+}
+
+int runRender(const Args& args) {
     const std::string input = args.onePositional("input .vdb file");
     const std::string output = args.require("-o");
     RenderSettings settings = settingsFromFlags(args);

@@ -1,6 +1,6 @@
 // cli/cmd_study.cpp — `vdbsplat study`: a whole antialiasing study in one command.
-// Owns: the study flags (the render flags through render_flags.h, minus --mode and the camera
-// placement, which the study varies), the plan (volumes × kernels × views × modes, every grid
+// Owns: the study flags (declared here; the render flags through render_flags.h, minus --mode,
+// --kernel and the camera placement, which the study varies), the plan (volumes × kernels × views × modes, every grid
 // loaded once and every camera built before anything is written), the output folder protocol
 // (refuse a non-empty folder without --resume/--force; every file atomic; a finished render is
 // <stem>.exr + <stem>.png + <stem>.json, the JSON written last with the fingerprint of what
@@ -9,8 +9,8 @@
 // tables and plots are in study/.
 //
 // Kernels: each --kernels value is handed to the render flags' own parser as `--kernel NAME`
-// (settingsFromFlags), so every kernel the render command accepts works here unchanged; while
-// the render flags have no --kernel, only the built-in Gaussian ("gaussian") exists.
+// (settingsFromFlags), so every kernel the render command accepts works here unchanged.
+#include <CLI/App.hpp>
 #include <tbb/global_control.h>
 #include <unistd.h>
 
@@ -31,7 +31,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/args.h"
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/interrupt.h"
 #include "cli/render_flags.h"
@@ -54,54 +54,11 @@ namespace {
 namespace fs = std::filesystem;
 using study::View;
 
-const char* kHelp =
-    "usage: vdbsplat study FILE.vdb [FILE.vdb ...] -o DIR [options]\n"
-    "\n"
-    "Runs an antialiasing study: every volume (each loaded once), kernel and view is rendered by\n"
-    "the reference (once, shared by the modes) and by every mode; DIR receives index.html (image\n"
-    "grid per view, error heat maps with a colour bar, crops of the worst window, PSNR/SSIM/time\n"
-    "against zoom plots, the metrics table; self-contained), metrics.csv, metrics.json,\n"
-    "command.txt and the images under DIR/images/VOLUME/KERNEL/VIEW/ (MODE.png for viewing,\n"
-    "MODE.exr for the metrics, MODE.json: what made it; MODE-error.png, MODE-crop.png).\n"
-    "\n"
-    "study:\n"
-    "  -o DIR             output folder (created; its parent must exist). A non-empty DIR is refused\n"
-    "                     unless --resume or --force is given\n"
-    "  --modes LIST       comma-separated forward modes as --mode takes them (default: every forward\n"
-    "                     mode of this build: hybrid, splat, point, and ewa, swan, none where built)\n"
-    "  --kernels LIST     reconstruction kernels as render's --kernel takes them (default: the render\n"
-    "                     default); the reference of each kernel uses that kernel\n"
-    "  --views LIST       standard (distance 8, 1, 0.35) and/or ladder (zoom 1/8x, 1/4x, 1/2x, 1x,\n"
-    "                     2x, 4x, 8x: distance --base / zoom); default standard\n"
-    "  --base K           the ladder's 1x framing distance (default 1)\n"
-    "  --distances LIST   further views at these framing distances (alone: only these)\n"
-    "  --size WxH         image size (default 200x200: a study renders many images)\n"
-    "  --spp N            reference rays per pixel (default 16, rounded up to a square)\n"
-    "  --tfs LIST         one transfer function per volume, in their order (instead of --tf: e.g.\n"
-    "                     grey,grey,ct-bone for two generated volumes and a CT)\n"
-    "  --resume           keep the finished renders in DIR whose settings fingerprint, size and files\n"
-    "                     check out, render the rest (changed settings: only what they change)\n"
-    "  --force            start afresh in a non-empty DIR (removes images/, index.html, metrics.*,\n"
-    "                     command.txt)\n"
-    "  --spec FILE.json   the study's volumes and settings from a file (docs/usage.md, \"study\"):\n"
-    "                     {\"volumes\": [...], \"modes\": [...], \"views\": [...], \"size\": [W, H], ...};\n"
-    "                     flags on the command line add to it (not the same setting twice)\n"
-    "\n"
-    "render flags (as vdbsplat render; the same for every mode and view):\n"
-    "  --grid NAME, --tf PRESET|FILE, --fov DEG, --up X,Y,Z, --view-dir X,Y,Z, --threshold PX,\n"
-    "  --lod PX, --simd on|off, --footprint P, --filter-order O, --subpixels K, --tables DIR,\n"
-    "  --max-voxels N, --show-primitives, --threads N, and the shading and emission flags below\n"
-    "  (see vdbsplat render --help)\n"
-    "\n"
-    "Ctrl-C or SIGTERM stops within the render under way (a second one stops at once): the\n"
-    "finished renders stay, nothing is half-written, exit 1; run again with --resume.\n"
-    "Prints a summary line on stdout (renders made and kept).\n";
-
 /// Render flags the study sets itself (per mode, per view) or replaces (--kernel → --kernels).
 const std::set<std::string> kStudyOwned{"--mode", "--distance", "--eye", "--look-at", "--kernel"};
 /// The forward modes a default study compares: those of this build that parseRenderMode accepts.
 const char* const kCandidateModes[] = {"hybrid", "splat", "point", "ewa", "swan", "none"};
-/// The one reconstruction kernel of a build whose render flags have no --kernel.
+/// The kernel name when the settings JSON names none (the built-in Gaussian).
 const char* const kBuiltInKernel = "gaussian";
 constexpr size_t kMaxVolumes = 64, kMaxModes = 16, kMaxKernels = 8;
 const char* const kDefaultSize = "200x200";
@@ -122,36 +79,13 @@ struct Options {
     bool resume = false, force = false;
 };
 
-bool kernelFlagKnown() { return renderValueFlags().count("--kernel") > 0; }
-
-std::set<std::string> studyValueFlags() {
-    std::set<std::string> flags;
-    for (const std::string& f : renderValueFlags())
-        if (!kStudyOwned.count(f)) flags.insert(f);
-    flags.insert({"-o", "--modes", "--kernels", "--views", "--base", "--distances", "--spec", "--tfs"});
-    return flags;
-}
-
-/// The render flags given to the study, as an argument list settingsFromFlags can parse again.
-std::vector<std::string> renderArgv(const Args& args) {
-    std::vector<std::string> out;
-    for (const std::string& f : renderValueFlags())
-        if (!kStudyOwned.count(f))
-            if (auto v = args.get(f)) out.insert(out.end(), {f, *v});
-    if (!args.has("--size")) out.insert(out.end(), {"--size", kDefaultSize});
-    if (args.has("--show-primitives")) out.push_back("--show-primitives");
-    return out;
-}
-
-/// The settings of one kernel through the render flags' parser (see the file comment).
-RenderSettings settingsWithKernel(std::vector<std::string> argv, const std::optional<std::string>& kernel) {
-    if (kernel) {
-        if (kernelFlagKnown()) argv.insert(argv.end(), {"--kernel", *kernel});
-        else if (*kernel != kBuiltInKernel)
-            throw Error("--kernels: unknown kernel '" + *kernel + "' (this build has only '" + kBuiltInKernel + "')");
-    }
+/// The render flags given to the study (with the study's default size), and @p kernel as
+/// --kernel when given, through the render flags' parser (see the file comment).
+RenderSettings settingsWithKernel(Args flags, const std::optional<std::string>& kernel) {
+    if (!flags.has("--size")) flags.set("--size", kDefaultSize);
+    if (kernel) flags.set("--kernel", *kernel);
     try {
-        return settingsFromFlags(Args(argv, renderValueFlags(), {"--show-primitives"}));
+        return settingsFromFlags(flags);
     } catch (const Error& e) {
         const std::string m = e.what();
         if (m.rfind("--kernel:", 0) == 0) throw Error("--kernels:" + m.substr(9));
@@ -165,18 +99,17 @@ std::string defaultKernelName(const RenderSettings& s) {
 }
 
 std::vector<KernelPlan> kernelsFrom(const Args& args) {
-    const std::vector<std::string> argv = renderArgv(args);
     std::vector<KernelPlan> kernels;
     if (auto v = args.get("--kernels")) {
         for (const std::string& k : splitList(*v, "--kernels")) {
             for (const KernelPlan& p : kernels)
                 if (p.name == k) throw Error("--kernels: '" + k + "' given more than once");
             if (study::safeId(k) != k) throw Error("--kernels: '" + printable(k) + "' is not a kernel name");
-            kernels.push_back({k, settingsWithKernel(argv, k)});
+            kernels.push_back({k, settingsWithKernel(args, k)});
         }
         if (kernels.size() > kMaxKernels) throw Error("--kernels: at most " + std::to_string(kMaxKernels) + " kernels");
     } else {
-        RenderSettings s = settingsWithKernel(argv, std::nullopt);
+        RenderSettings s = settingsWithKernel(args, std::nullopt);
         kernels.push_back({study::safeId(defaultKernelName(s)), s});
     }
     return kernels;
@@ -564,14 +497,13 @@ void appendCommand(const fs::path& dir, const std::string& command) {
     writeTextFileAtomic((dir / "command.txt").string(), previous + command + "\n");
 }
 
-const std::set<std::string> kSwitches{"--show-primitives", "--resume", "--force"};
-
-/// The command line with --spec FILE replaced by the arguments the file stands for (its volumes
-/// first). @p fromSpec receives flag → key for the flags the file gave.
+/// The study's flags with --spec FILE replaced by the arguments the file stands for (its volumes
+/// first), parsed again by the study's own declarations. @p fromSpec receives flag → key for
+/// the flags the file gave.
 /// @throw Error naming the file for a bad file, or a setting given both there and as a flag.
-Argv withSpec(const Argv& argv, const Args& args, std::map<std::string, std::string>& fromSpec) {
+Args withSpec(const Args& args, std::map<std::string, std::string>& fromSpec) {
+    const Argv& argv = args.words();
     const auto spec = args.get("--spec");
-    if (!spec) return argv;
     if (spec->empty()) throw Error("--spec: expected a file name, got ''");
     Argv volumes, flags;
     for (const study::SpecArgument& a : study::loadSpec(*spec)) {
@@ -593,7 +525,9 @@ Argv withSpec(const Argv& argv, const Args& args, std::map<std::string, std::str
         if (argv[i].rfind("--spec=", 0) == 0) continue;
         out.push_back(argv[i]);
     }
-    return out;
+    CLI::App again;
+    declareStudy(again);
+    return parseAlone(again, out);
 }
 
 /// optionsFrom, with a bad value that came from the study file named by the file and its key.
@@ -611,15 +545,52 @@ Options optionsWithSpec(const Args& args, const std::map<std::string, std::strin
 
 }  // namespace
 
-int runStudy(const Argv& argv) {
-    const Args given(argv, studyValueFlags(), kSwitches);
-    if (given.wantsHelp()) {
-        std::cout << kHelp << "\nshading (docs/shading.md):\n" << kShadingHelp << "\nemission (docs/emission.md):\n"
-                  << kEmissionHelp;
-        return 0;
-    }
+void declareStudy(CLI::App& app) {
+    app.description(
+        "antialiasing study: every mode and view against the reference, HTML report\n"
+        "\n"
+        "usage: vdbsplat study FILE.vdb [FILE.vdb ...] -o DIR [options]\n"
+        "\n"
+        "Runs an antialiasing study: every volume (each loaded once), kernel and view is rendered by\n"
+        "the reference (once, shared by the modes) and by every mode; DIR receives index.html (image\n"
+        "grid per view, error heat maps with a colour bar, crops of the worst window, PSNR/SSIM/time\n"
+        "against zoom plots, the metrics table; self-contained), metrics.csv, metrics.json,\n"
+        "command.txt and the images under DIR/images/VOLUME/KERNEL/VIEW/ (MODE.png for viewing,\n"
+        "MODE.exr for the metrics, MODE.json: what made it; MODE-error.png, MODE-crop.png).\n"
+        "The render flags are as for vdbsplat render, the same for every mode and view.");
+    addPositional(app, "FILE.vdb", "the volumes to study (or from --spec)", true);
+    addValueFlag(app, "-o", "DIR", "output folder (created; its parent must exist). A non-empty DIR is\n"
+                                   "refused unless --resume or --force is given")
+        ->required();
+    addValueFlag(app, "--modes", "LIST", "comma-separated forward modes as --mode takes them (default: every\n"
+                                         "forward mode of this build: hybrid, splat, point, ewa, swan, none)");
+    addValueFlag(app, "--kernels", "LIST", "reconstruction kernels as render's --kernel takes them (default:\n"
+                                           "the render default); the reference of each kernel uses that kernel");
+    addValueFlag(app, "--views", "LIST", "standard (distance 8, 1, 0.35) and/or ladder (zoom 1/8x, 1/4x,\n"
+                                         "1/2x, 1x, 2x, 4x, 8x: distance --base / zoom); default standard");
+    addValueFlag(app, "--base", "K", "the ladder's 1x framing distance (default 1)");
+    addValueFlag(app, "--distances", "LIST", "further views at these framing distances (alone: only these)");
+    addValueFlag(app, "--tfs", "LIST", "one transfer function per volume, in their order (instead of --tf:\n"
+                                       "e.g. grey,grey,ct-bone for two generated volumes and a CT)");
+    addSwitch(app, "--resume", "keep the finished renders in DIR whose settings fingerprint, size and\n"
+                               "files check out, render the rest (changed settings: only what they\n"
+                               "change)");
+    addSwitch(app, "--force", "start afresh in a non-empty DIR (removes images/, index.html,\n"
+                              "metrics.*, command.txt)");
+    addValueFlag(app, "--spec", "FILE.json", "the study's volumes and settings from a file (docs/usage.md,\n"
+                                             "\"study\"): {\"volumes\": [...], \"modes\": [...], \"views\": [...],\n"
+                                             "\"size\": [W, H], ...}; flags on the command line add to it (not\n"
+                                             "the same setting twice)");
+    addRenderFlags(app, kStudyOwned);
+    app.footer(
+        "Ctrl-C or SIGTERM stops within the render under way (a second one stops at once): the\n"
+        "finished renders stay, nothing is half-written, exit 1; run again with --resume.\n"
+        "Prints a summary line on stdout (renders made and kept).");
+}
+
+int runStudy(const Args& given) {
     std::map<std::string, std::string> fromSpec;
-    const Args args(withSpec(argv, given, fromSpec), studyValueFlags(), kSwitches);
+    const Args args = given.has("--spec") ? withSpec(given, fromSpec) : given;
     const Options o = optionsWithSpec(args, fromSpec, given.getOr("--spec", ""));
     checkFolder(o);
     const RenderSettings& base = o.kernels.front().settings;
@@ -644,7 +615,7 @@ int runStudy(const Argv& argv) {
 
     prepareFolder(o);
     const fs::path dir(o.dir);
-    const std::string command = commandLine(argv);
+    const std::string command = commandLine(given.words());
     appendCommand(dir, command);
 
     study::StudyResult result;

@@ -3,7 +3,9 @@
 #include <cstdio>
 #include <iostream>
 
-#include "cli/args.h"
+#include <CLI/App.hpp>
+
+#include "cli/command_line.h"
 #include "cli/commands.h"
 #include "footprint/kernel.h"
 #include "footprint/tables.h"
@@ -12,15 +14,6 @@
 namespace vdbsplat::cli {
 
 namespace {
-const char* kHelp =
-    "usage: vdbsplat tables --out DIR      write footprint.table, footprint-gaussian-sharp.table\n"
-    "                                      (one per --kernel) and reindex.table into DIR\n"
-    "       vdbsplat tables --check [DIR]  verify DIR (default: the shipped tables/ directory):\n"
-    "                                      header, kernel, checksum, and byte-for-byte equality\n"
-    "                                      with a fresh build; exits non-zero on any mismatch\n"
-    "\n"
-    "The footprint table is F(d²), the kernel's line integral at normalised ray-centre\n"
-    "distance d; the reindex table is d²(i², α) for α in [0°, 15°] (DESIGN §3).\n";
 
 int writeTables(const std::string& dir) {
     for (const KernelShape* kernel : {&KernelShape::standard(), &KernelShape::sharp()}) {
@@ -38,12 +31,22 @@ int writeTables(const std::string& dir) {
 }
 }  // namespace
 
-int runTables(const Argv& argv) {
-    const Args args(argv, {"--out"}, {"--check"});
-    if (args.wantsHelp()) {
-        std::cout << kHelp;
-        return 0;
-    }
+void declareTables(CLI::App& app) {
+    app.description(
+        "regenerate or check the footprint and reindex tables\n"
+        "\n"
+        "usage: vdbsplat tables --out DIR | --check [DIR]\n"
+        "\n"
+        "The footprint table is F(d²), the kernel's line integral at normalised ray-centre\n"
+        "distance d; the reindex table is d²(i², α) for α in [0°, 15°] (DESIGN §3).");
+    addPositional(app, "DIR", "with --check: the folder to verify (default: the shipped tables/)");
+    addValueFlag(app, "--out", "DIR", "write footprint.table, footprint-gaussian-sharp.table (one per\n"
+                                      "--kernel) and reindex.table into DIR");
+    addSwitch(app, "--check", "verify DIR: header, kernel, checksum, and byte-for-byte equality\n"
+                              "with a fresh build; exits non-zero on any mismatch");
+}
+
+int runTables(const Args& args) {
     const bool check = args.has("--check"), out = args.has("--out");
     if (check == out) throw Error("tables: give exactly one of --out DIR or --check [DIR] (see --help)");
     if (out) {

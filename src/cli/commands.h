@@ -1,23 +1,35 @@
 // cli/commands.h — the subcommands of the `vdbsplat` binary.
-// Owns: one entry point per subcommand, each in its own cmd_*.cpp. Each takes
-// the arguments after the subcommand name, prints its --help when asked,
-// returns 0 on success and throws Error on bad input (main.cpp prints it).
+// Owns: two entry points per subcommand, each pair in its own cmd_*.cpp: declareX adds the
+// command's usage, description and flags to its CLI::App (the one declaration of each flag;
+// --help is generated from it), runX runs it with what was parsed, returns 0 on success and
+// throws Error on bad input (main.cpp prints it). main.cpp lists the commands.
 #pragma once
-#include <string>
-#include <vector>
+#include "cli/args.h"
+
+namespace CLI {
+class App;
+}
 
 namespace vdbsplat::cli {
 
-using Argv = std::vector<std::string>;
+void declareInfo(CLI::App& app);      ///< vdbsplat info FILE.vdb
+void declareGenerate(CLI::App& app);  ///< vdbsplat generate KIND -o OUT.vdb …
+void declareConvert(CLI::App& app);   ///< vdbsplat convert IN.raw[.gz] -o OUT.vdb …
+void declareRender(CLI::App& app);    ///< vdbsplat render FILE.vdb -o OUT.png|exr …
+void declareTables(CLI::App& app);    ///< vdbsplat tables --out DIR | --check
+void declareBench(CLI::App& app);     ///< vdbsplat bench FILE.vdb …
+void declareCompare(CLI::App& app);   ///< vdbsplat compare A B (PSNR, …)
+void declareAnimate(CLI::App& app);   ///< vdbsplat animate FILE.vdb -o DIR (zoom, orbit or keyframes)
+void declareStudy(CLI::App& app);     ///< vdbsplat study FILE.vdb… -o DIR (antialiasing study and report)
 
-int runInfo(const Argv& args);      ///< vdbsplat info FILE.vdb
-int runGenerate(const Argv& args);  ///< vdbsplat generate KIND -o OUT.vdb …
-int runConvert(const Argv& args);   ///< vdbsplat convert IN.raw[.gz] -o OUT.vdb …
-int runRender(const Argv& args);    ///< vdbsplat render FILE.vdb -o OUT.png|exr …
-int runTables(const Argv& args);    ///< vdbsplat tables --out DIR | --check
-int runBench(const Argv& args);     ///< vdbsplat bench FILE.vdb …
-int runCompare(const Argv& args);   ///< vdbsplat compare A B (PSNR, …)
-int runAnimate(const Argv& args);   ///< vdbsplat animate FILE.vdb -o DIR (zoom, orbit or keyframes)
-int runStudy(const Argv& args);     ///< vdbsplat study FILE.vdb… -o DIR (antialiasing study and report)
+int runInfo(const Args& args);
+int runGenerate(const Args& args);
+int runConvert(const Args& args);
+int runRender(const Args& args);
+int runTables(const Args& args);
+int runBench(const Args& args);
+int runCompare(const Args& args);
+int runAnimate(const Args& args);
+int runStudy(const Args& args);
 
 }  // namespace vdbsplat::cli

@@ -1,37 +1,124 @@
-// cli/render_flags.cpp — render flags → RenderSettings (see render_flags.h).
+// cli/render_flags.cpp — the render flags: their declarations and → RenderSettings (see render_flags.h).
 #include "cli/render_flags.h"
 
+#include <CLI/App.hpp>
+
+#include "cli/command_line.h"
 #include "footprint/kernel.h"
 #include "util/error.h"
 #include "util/parse.h"
 
 namespace vdbsplat::cli {
 
-const std::set<std::string>& renderValueFlags() {
-    static const std::set<std::string> flags{"--grid",   "--mode",      "--size",      "--tf",    "--eye",
-                                             "--look-at", "--up",       "--view-dir",  "--fov",   "--distance",
-                                             "--threads", "--spp",      "--threshold", "--lod",   "--footprint",
-                                             "--tables",  "--simd", "--max-voxels", "--filter-order", "--subpixels", "--kernel", "--shading",
-                                             "--ambient", "--diffuse",  "--specular",  "--shininess",
-                                             "--light",   "--gradient-opacity", "--emission", "--emission-map",
-                                             "--emission-scale", "--kelvin"};
-    return flags;
+namespace {
+
+/// One render flag: its name, its value as the help shows it (nullptr: a switch), the help
+/// group it is listed under, and its help text (lines of at most 76 characters).
+struct RenderFlag {
+    const char* name;
+    const char* value;
+    const char* group;
+    const char* help;
+};
+
+constexpr const char* kScene = "scene";
+constexpr const char* kCamera = "camera";
+constexpr const char* kQuality = "rendering";
+constexpr const char* kShading = "shading (docs/shading.md)";
+constexpr const char* kEmission = "emission (docs/emission.md)";
+
+/// Every render flag, declared once: render, animate, study and bench add them from here.
+constexpr RenderFlag kRenderFlags[] = {
+    {"--grid", "NAME", kScene, "grid to render (default: the grid named density, else the first\n"
+                               "float or double grid)"},
+    {"--tf", "PRESET|FILE", kScene, "transfer function: grey (default), ct-bone, fire, or a JSON file"},
+    {"--mode", "MODE", kScene,
+     "hybrid (default) | splat | point | ewa | swan | none | reference\n"
+     "ewa: Zwicker et al. 2001 affine (Jacobian) splats + low-pass; swan: Swan\n"
+     "et al. 1997, minified footprints stretched to the pixel filter; none: no\n"
+     "low-pass (splats without it, points to the nearest pixel); ewa, swan and\n"
+     "none ignore --filter-order/--subpixels (docs/modes.md)"},
+    {"--kernel", "K", kScene,
+     "reconstruction kernel, every mode and the reference: gaussian (default,\n"
+     "s_g 0.65, R 2) | gaussian-sharp (s_g 0.5, R 1.55: less blur when\n"
+     "magnified, more ripple; docs/kernel.md)"},
+    {"--size", "WxH", kScene, "image size in pixels, each side 1..16384 (default 400x400; study:\n"
+                              "200x200)"},
+    {"--eye", "X,Y,Z", kCamera, "camera position (world); default: frame the grid from a fixed oblique\n"
+                                "view"},
+    {"--look-at", "X,Y,Z", kCamera, "point looked at, with --eye (default: the centre of the grid's bounds)"},
+    {"--up", "X,Y,Z", kCamera, "up vector (default 0,0,1); animate's zoom and orbit: also the orbit axis"},
+    {"--view-dir", "X,Y,Z", kCamera, "without --eye: frame the grid from this direction (centre to eye;\n"
+                                     "default 0.9,-1.3,0.75)"},
+    {"--fov", "DEG", kCamera, "vertical field of view in (0, 170) degrees (default 30; animate --path:\n"
+                              "for keys without fov)"},
+    {"--distance", "K", kCamera, "multiplies the framing distance (default 1; 8 far, 1 framed, 0.35\n"
+                                 "close); animate --orbit: the orbit's framing distance"},
+    {"--threshold", "PX", kQuality, "minification threshold: voxels projecting under PX pixels are points\n"
+                                    "(default 1)"},
+    {"--lod", "PX", kQuality,
+     "level of detail: points are merged into aggregates of 2^3, 4^3 or 8^3\n"
+     "voxels (same total optical depth, centroid and spread) whose side\n"
+     "projects to at most PX pixels, 0..64 (default 1.25; 0 turns it off)"},
+    {"--footprint", "P", kQuality,
+     "auto (default): the (i, alpha) reindex table, and the exact ray-centre\n"
+     "distance for splats far off the axis where the affine index is off;\n"
+     "table: the reindex table for every splat; exact: closed form per pixel"},
+    {"--filter-order", "O", kQuality,
+     "where the pixel prefilter goes: postfilter (default): composite on a\n"
+     "grid with a small low-pass, then low-pass the composited image (right\n"
+     "for thin dense structures); prefilter: EWA's order, low-pass each\n"
+     "primitive's optical depth, then composite (too opaque for structures\n"
+     "1-2 px wide)"},
+    {"--subpixels", "K", kQuality,
+     "postfilter: composite on K x K sub-pixels per pixel, 1..8 (default 1;\n"
+     "2 is closer to the reference, at up to 3.5x the time at close views)"},
+    {"--simd", "on|off", kQuality, "splats through the vector loop (default on) or the scalar table path"},
+    {"--show-primitives", nullptr, kQuality, "tint splats red, points keep their colour"},
+    {"--tables", "DIR", kQuality,
+     "footprint.table and reindex.table from DIR (default: the shipped\n"
+     "tables/); a file absent from DIR is built in memory, a corrupt one or\n"
+     "one built for another kernel is refused (the forward modes)"},
+    {"--spp", "N", kQuality, "reference: rays per pixel, 1..1024 (default 16, rounded up to a square)"},
+    {"--max-voxels", "N", kQuality,
+     "refuse grids with more than N active voxels, active tiles counted voxel\n"
+     "by voxel (default 2^30 = 1073741824, at most 2^32)"},
+    {"--threads", "N", kQuality, "worker threads, 0..1024 (default 0: all cores); the image does not\n"
+                                 "depend on it"},
+    {"--shading", "S", kShading,
+     "off (default) | phong | ct: gradient-based Blinn-Phong, computed per\n"
+     "voxel before rendering (every mode, the reference too); ct: phong with\n"
+     "the CT preset (ambient 0.25, diffuse 0.75, specular 0.35, shininess 24)"},
+    {"--ambient", "K", kShading, "ambient coefficient in [0, 1] (default 0.3; needs --shading)"},
+    {"--diffuse", "K", kShading, "diffuse coefficient in [0, 1] (default 0.7; needs --shading)"},
+    {"--specular", "K", kShading, "specular coefficient in [0, 1] (default 0.2; needs --shading)"},
+    {"--shininess", "P", kShading, "specular exponent in [1, 1000] (default 20; needs --shading)"},
+    {"--light", "X,Y,Z", kShading, "directional light, world direction towards the light (default: a\n"
+                                   "headlight at the eye; needs --shading)"},
+    {"--gradient-opacity", "K", kShading,
+     "scale each voxel's extinction by 1 - exp(-K |grad|), |grad| in\n"
+     "normalised value per voxel, 0..1e6 (default 0: off)"},
+    {"--emission", "GRID", kEmission,
+     "add the emission of scalar grid GRID of the same file (e.g.\n"
+     "temperature, flame; same transform as the density grid) on the\n"
+     "density's kernels"},
+    {"--emission-map", "M", kEmission,
+     "blackbody (default): value -> Kelvin (--kelvin) -> Planck colour,\n"
+     "brightness (T^4 - LO^4)/(HI^4 - LO^4); or a transfer function (preset\n"
+     "or JSON file) whose emission sigma*c is used without its extinction"},
+    {"--emission-scale", "K", kEmission, "emitted radiance per voxel length at the map's brightest value,\n"
+                                         "0..1e6 (default 1)"},
+    {"--kelvin", "LO,HI", kEmission, "blackbody: Kelvin at normalised value 0 and 1 (default 1500,6500)"},
+};
+
+/// @brief --filter-order and --subpixels into @p s. @throw Error naming the flag.
+void applyFilterFlags(const Args& args, RenderSettings& s) {
+    if (auto v = args.get("--filter-order")) s.filterOrder = parseFilterOrder(*v);
+    if (auto v = args.get("--subpixels")) s.subpixels = int(parseInt(*v, "--subpixels", 1, kMaxSubpixels));
 }
 
-const std::set<std::string>& emissionValueFlags() {
-    static const std::set<std::string> flags{"--emission", "--emission-map", "--emission-scale", "--kelvin"};
-    return flags;
-}
-
-const char* const kEmissionHelp =
-    "  --emission GRID    add the emission of scalar grid GRID of the same file (e.g. temperature,\n"
-    "                     flame; same transform as the density grid) on the density's kernels\n"
-    "  --emission-map M   blackbody (default): value -> Kelvin (--kelvin) -> Planck colour, brightness\n"
-    "                     (T^4 - LO^4)/(HI^4 - LO^4); or a transfer function (preset or JSON file) whose\n"
-    "                     emission sigma*c is used without its extinction\n"
-    "  --emission-scale K emitted radiance per voxel length at the map's brightest value (default 1)\n"
-    "  --kelvin LO,HI     blackbody: Kelvin at normalised value 0 and 1 (default 1500,6500)\n";
-
+/// @brief The validated emission settings the emission flags in @p args describe.
+/// @throw Error naming the first bad flag (a bad value, or a map flag without --emission).
 EmissionSettings emissionFromFlags(const Args& args) {
     EmissionSettings e;
     if (auto v = args.get("--emission")) {
@@ -51,25 +138,8 @@ EmissionSettings emissionFromFlags(const Args& args) {
     return e;
 }
 
-const std::set<std::string>& shadingValueFlags() {
-    static const std::set<std::string> flags{"--shading",   "--ambient", "--diffuse",         "--specular",
-                                             "--shininess", "--light",   "--gradient-opacity"};
-    return flags;
-}
-
-const char* const kShadingHelp =
-    "  --shading S        off (default) | phong | ct: gradient-based Blinn-Phong, computed per voxel\n"
-    "                     before rendering (every mode, the reference too); ct: phong with the CT\n"
-    "                     preset (ambient 0.25, diffuse 0.75, specular 0.35, shininess 24)\n"
-    "  --ambient K        ambient coefficient in [0, 1] (default 0.3; needs --shading)\n"
-    "  --diffuse K        diffuse coefficient in [0, 1] (default 0.7; needs --shading)\n"
-    "  --specular K       specular coefficient in [0, 1] (default 0.2; needs --shading)\n"
-    "  --shininess P      specular exponent in [1, 1000] (default 20; needs --shading)\n"
-    "  --light X,Y,Z      directional light, world direction towards the light (default: a\n"
-    "                     headlight at the eye; needs --shading)\n"
-    "  --gradient-opacity K  scale each voxel's extinction by 1 - exp(-K |grad|), |grad| in\n"
-    "                     normalised value per voxel (default 0: off; see docs/shading.md)\n";
-
+/// @brief The validated shading settings the shading flags in @p args describe.
+/// @throw Error naming the first bad flag (a bad value, or a lighting flag without --shading).
 ShadingSettings shadingFromFlags(const Args& args) {
     ShadingSettings s;
     if (auto v = args.get("--shading")) {
@@ -94,6 +164,16 @@ ShadingSettings shadingFromFlags(const Args& args) {
     }
     s.validate();
     return s;
+}
+
+}  // namespace
+
+void addRenderFlags(CLI::App& app, const std::set<std::string>& leaveOut) {
+    for (const RenderFlag& f : kRenderFlags) {
+        if (leaveOut.count(f.name)) continue;
+        CLI::Option* o = f.value ? addValueFlag(app, f.name, f.value, f.help) : addSwitch(app, f.name, f.help);
+        o->group(f.group);
+    }
 }
 
 glm::dvec3 parseVec3(const std::string& text, const std::string& flag) {
@@ -142,11 +222,6 @@ RenderSettings settingsFromFlags(const Args& args) {
     }
     s.validate();
     return s;
-}
-
-void applyFilterFlags(const Args& args, RenderSettings& s) {
-    if (auto v = args.get("--filter-order")) s.filterOrder = parseFilterOrder(*v);
-    if (auto v = args.get("--subpixels")) s.subpixels = int(parseInt(*v, "--subpixels", 1, kMaxSubpixels));
 }
 
 void resolveLookAt(const Args& args, const Volume& volume, RenderSettings& settings) {
