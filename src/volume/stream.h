@@ -23,6 +23,7 @@
 
 #include "camera/camera.h"
 #include "volume/grid.h"
+#include "volume/leaf_moments.h"
 #include "volume/transfer_function.h"
 
 namespace vdbsplat {
@@ -71,6 +72,15 @@ struct StreamOptions {
     /// only while the spread a cell adds stays within kLodMaxSpreadRatio of the variance of the
     /// points it replaces (pointFilterVariance with the pass's low-pass below).
     double lodCellPx = 1.0;
+    /// Level of detail, blended: the width, in levels, over which a block passes from one level
+    /// to the next (0: the level switches at once). EXPERIMENT: placement below.
+    double lodBlend = 1.0;
+    /// Where the blend lies: it starts this many levels before the coarser level becomes
+    /// admissible (0: the coarser level is only mixed in once it is admissible).
+    double lodBlendLead = 0.0;
+    /// Within a blending block each cell passes over this fraction of the block's blend (placed
+    /// by a hash of the cell): 1, every cell blends at once (all drawn twice); small, cell by cell.
+    double lodCellRamp = 1.0;
     /// The low-pass folded into each point (px²: V_h, or V_s on the postfilter's sub-pixel grid).
     double pointPrefilterVariance = 1.0;
     /// Voxels whose projected spacing h·f/z is under this many pixels are drawn as points by
@@ -121,14 +131,18 @@ private:
         float dMin, dMax;               // distance range of its voxel centres (world)
         uint32_t voxels;                // active voxels
         int lodLevel;                   // 0: voxel by voxel; L ≥ 1: aggregates of (2^L)³ cells
+        float lodFine;                  // blend: weight of level lodLevel − 1 (0: level lodLevel alone)
     };
     void collectBlocks();
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
-    int lodLevel(const Block& b) const;
-    void extract(const Block& b, VoxelBatch& out) const;
-    void extractAggregates(const Block& b, VoxelBatch& out) const;
-    template <typename Fn> void forEachActive(const Block& b, Fn&& fn) const;
+    void lodLevel(Block& b) const;  // sets b.lodLevel and b.lodFine
+    void extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const;  // counts: aggregates only
+    void extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const;
+    void cellMoments(const Block& b, int level, CellMoments* acc) const;
+    void emitCells(const Block& b, int level, const CellMoments* acc, const float* coarse, bool fineSide,
+                   VoxelBatch& out, StreamCounts& counts) const;
+    template <typename Keep, typename Fn> void forEachActive(const Block& b, Keep&& keep, Fn&& fn) const;
     void adaptWindow(size_t released);  // the next window's slab count from this one's size
     void release(size_t blocks, float limit, VoxelBatch& batch);  // pending + extracted → batch, pending
 
@@ -145,6 +159,7 @@ private:
     VoxelBatch pendingNext_;      // the pending voxels a window keeps (swapped with pending_)
     std::vector<VoxelBatch> extracted_;  // per activated block of the window (reused)
     std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
+    std::vector<StreamCounts> blockCounts_;  // per activated block: its aggregates
     int64_t nextSlab_ = 0;
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
     glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)
