@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdlib>
 #include <optional>
 
 #include "footprint/ellipsoid.h"
@@ -68,9 +67,6 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
         diagonal = std::max(diagonal, glm::length(A * glm::dvec3(1.0, s & 1 ? -1.0 : 1.0, s & 2 ? -1.0 : 1.0)));
     blockHalfDiagonal_ = 0.5 * (kBlockDim - 1) * (volume_.isotropic ? std::sqrt(3.0) * volume_.voxelSize : diagonal);
     largestAxis_ = volume_.isotropic ? volume_.voxelSize : singularValues(A).x;
-    if (const char* e = std::getenv("VDBSPLAT_LOD_BLEND")) options_.lodBlend = std::atof(e);  // EXPERIMENT
-    if (const char* e = std::getenv("VDBSPLAT_LOD_LEAD")) options_.lodBlendLead = std::atof(e);  // EXPERIMENT
-    if (const char* e = std::getenv("VDBSPLAT_LOD_RAMP")) options_.lodCellRamp = std::atof(e);  // EXPERIMENT
     collectBlocks();
 }
 
@@ -170,20 +166,30 @@ void VoxelStream::lodLevel(Block& b) const {
     // The block's largest projected voxel spacing (the longest voxel axis: as the projection decides).
     const double spacingPx = largestAxis_ * camera_.focal() / zNear;
     if (!(spacingPx < options_.pointBelowPx)) return;     // some voxel may be a splat
-    // The continuous admissible level ℓ: a cell of n = 2^ℓ voxels per side projects to n·s px
-    // (at most lodCellPx) and, uniform, adds the spread s²·(n² − 1)/12 px² per axis (s the
-    // projected spacing), at most kLodMaxSpreadRatio of the points' own filter variance.
+    // The admissible level ℓ, continuous: a cell of n = 2^ℓ voxels per side projects to n·s px (at
+    // most lodCellPx) and, uniform, would add the spread s²·(n² − 1)/12 px² per axis (s the projected
+    // spacing), at most kLodMaxSpreadRatio of the points' own filter variance.
     const double filter = pointFilterVariance(spacingPx, options_.pointPrefilterVariance);
     const double bySize = std::log2(options_.lodCellPx / spacingPx);
     const double bySpread = 0.5 * std::log2(1.0 + 12.0 * kLodMaxSpreadRatio * filter / (spacingPx * spacingPx));
-    const double ell = std::min(bySize, bySpread) + options_.lodBlendLead;
-    if (!(ell >= 1.0)) return;
-    const int k = int(std::min(std::floor(ell), 4.0));
-    const double frac = ell - double(k), width = std::min(options_.lodBlend, 1.0);
-    if (k <= 3 && frac < width) {  // passing from level k − 1 to level k
-        b.lodLevel = k;
-        b.lodFine = float(1.0 - frac / width);
-    } else b.lodLevel = std::min(k, 3);
+    const double ell = std::min(bySize, bySpread);
+    if (!options_.lodBlend) {  // the level switches at once where it becomes admissible
+        if (ell >= 1.0) b.lodLevel = int(std::min(std::floor(ell), 3.0));
+        return;
+    }
+    // Blended: the block passes from level k − 1 to level k while x = g(ℓ) goes from k to k + 1,
+    // with g(ℓ) = ℓ up to ℓ = 1.5 and ℓ + lodLead from ℓ = 2.5 on (linear between, so g is
+    // monotone and the passages do not overlap): voxels → 2³ over ℓ ∈ [1, 1.83) (with the default
+    // lead ½: never coarser than the switching rule), 2³ → 4³ over [1.83, 2.5), 4³ → 8³ over
+    // [2.5, 3.5) (centred on the switch).
+    const double x = ell + options_.lodLead * std::clamp(ell - 1.5, 0.0, 1.0);
+    if (!(x >= 1.0)) return;
+    if (x >= 4.0) {
+        b.lodLevel = 3;
+        return;
+    }
+    b.lodLevel = int(std::floor(x));
+    b.lodFine = float(1.0 - (x - double(b.lodLevel)));
 }
 
 namespace {
@@ -256,8 +262,8 @@ float cellRank(const openvdb::Coord& cell, int level) {
 
 // A block between two levels (lodFine > 0) passes from level k − 1 to level k cell by cell: each
 // cell of level k has a coarse weight w_c that rises from 0 to 1 as the block's weight t = 1 −
-// lodFine does, over its own stretch of t (a fraction lodCellRamp of it, placed by the cell's
-// rank), and is drawn at level k with its optical depth scaled by w_c and as its level-(k − 1)
+// lodFine does, over its own stretch of t (voxels → 2³: a fraction lodVoxelRamp of it, placed by the cell's
+// rank; between aggregates all of it), and is drawn at level k with its optical depth scaled by w_c and as its level-(k − 1)
 // children (or voxels) scaled by 1 − w_c. Optical depth is linear in σ, so each cell keeps its
 // energy exactly; the weights follow the camera continuously, so nothing pops; and only the cells
 // inside their stretch are drawn twice. The level with the larger weight carries the voxel counts
@@ -270,14 +276,16 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts)
         return emitCells(b, b.lodLevel, acc.data(), nullptr, false, out, counts);
     }
     const int k = b.lodLevel, parents = kBlockDim >> k;
-    const double t = 1.0 - double(b.lodFine), ramp = std::clamp(options_.lodCellRamp, 1e-3, 1.0);
+    // From the voxels, cell by cell (drawing a block twice would cost its voxels again); between
+    // aggregates, every cell at once (the finer level costs 8× fewer records than the voxels).
+    const double t = 1.0 - double(b.lodFine), ramp = k == 1 ? std::clamp(options_.lodVoxelRamp, 1e-3, 1.0) : 1.0;
     std::array<float, 64> coarse{};  // per level-k cell: its weight w_c at level k (1 − w_c at level k − 1)
     for (int cx = 0; cx < parents; ++cx)
         for (int cy = 0; cy < parents; ++cy)
             for (int cz = 0; cz < parents; ++cz) {
                 const size_t i = size_t((cx * parents + cy) * parents + cz);
                 const openvdb::Coord cell((b.origin.x() >> k) + cx, (b.origin.y() >> k) + cy, (b.origin.z() >> k) + cz);
-                const double w = std::clamp((t - double(cellRank(cell, k)) * (1.0 - ramp)) / ramp, 0.0, 1.0);
+                const double w = ramp >= 1.0 ? t : std::clamp((t - double(cellRank(cell, k)) * (1.0 - ramp)) / ramp, 0.0, 1.0);
                 coarse[i] = float(w);
             }
     if (k == 1) {
@@ -452,17 +460,18 @@ void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, c
                 // the spread is trace(J A Σ Aᵀ Jᵀ)/2 = Σ over the rows j of J of (Aᵀj)ᵀ Σ (Aᵀj).
                 const glm::dvec3 jx(f / v.z, 0.0, -f * v.x / (v.z * v.z)), jy(0.0, f / v.z, -f * v.y / (v.z * v.z));
                 const glm::dvec3 ux = jx * toView, uy = jy * toView;  // row vector · A = Aᵀj
-                const double spreadFull = 0.5 * (glm::dot(ux, cov * ux) + glm::dot(uy, cov * uy));
+                const double spread = 0.5 * (glm::dot(ux, cov * ux) + glm::dot(uy, cov * uy));
                 out.viewPos.emplace_back(v);
                 out.distance.push_back(float(glm::length(v)));
                 out.sigma.push_back(weight == 1.f ? a.m : a.m * weight);
                 out.color.push_back(a.emission / a.m);
-                static const double extra = std::getenv("VDBSPLAT_LOD_EXTRA") ? std::atof(std::getenv("VDBSPLAT_LOD_EXTRA")) : 0.0;  // EXPERIMENT
-                static const bool resid = std::getenv("VDBSPLAT_LOD_RESID") != nullptr;  // EXPERIMENT
-                const double uniform = (double(side) * side - 1.0) / 12.0 * 0.5 * (glm::dot(ux, ux) + glm::dot(uy, uy));
-                const double spread = resid ? std::max(0.0, spreadFull - uniform) : spreadFull;
-                static const double scale = std::getenv("VDBSPLAT_LOD_SCALE") ? std::atof(std::getenv("VDBSPLAT_LOD_SCALE")) : 1.0;  // EXPERIMENT
-                out.spread.push_back(float(std::max(spread * scale, 0.0) + extra));
+                // Only what exceeds a full cell's own second moment (s²·(n² − 1)/12 per index axis)
+                // is added: the cells' lattice already spreads a full cell's mass over the cell, as
+                // the voxels' lattice does a voxel's (a uniform region of cells is the same quadrature
+                // of the same field as its voxels, one level coarser). Adding it again blurred every
+                // surface by a cell (docs/animation.md, session 5).
+                const double full = (double(side) * side - 1.0) / 12.0 * 0.5 * (glm::dot(ux, ux) + glm::dot(uy, uy));
+                out.spread.push_back(float(std::max(spread - full, 0.0)));
                 out.members.push_back(counted ? a.n : 0);
                 if (counted) ++counts.aggregates, counts.aggregatedVoxels += a.n;
             }

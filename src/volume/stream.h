@@ -72,15 +72,17 @@ struct StreamOptions {
     /// only while the spread a cell adds stays within kLodMaxSpreadRatio of the variance of the
     /// points it replaces (pointFilterVariance with the pass's low-pass below).
     double lodCellPx = 1.0;
-    /// Level of detail, blended: the width, in levels, over which a block passes from one level
-    /// to the next (0: the level switches at once). EXPERIMENT: placement below.
-    double lodBlend = 1.0;
-    /// Where the blend lies: it starts this many levels before the coarser level becomes
-    /// admissible (0: the coarser level is only mixed in once it is admissible).
-    double lodBlendLead = 0.0;
-    /// Within a blending block each cell passes over this fraction of the block's blend (placed
-    /// by a hash of the cell): 1, every cell blends at once (all drawn twice); small, cell by cell.
-    double lodCellRamp = 1.0;
+    /// Level of detail, blended (docs/performance.md, "Level of detail"): a block passes from one
+    /// level to the next continuously as the camera moves, drawn at both with its optical depth
+    /// split between them, so no cell pops during a zoom; false: the level switches at once where
+    /// it becomes admissible (the rule before session 5; for tests and measurement).
+    bool lodBlend = true;
+    /// Blended: levels 4³ and 8³ are mixed in from this many levels before they become admissible
+    /// (½: each passage centred on the switch, the same level on average; 2³ only once admissible).
+    double lodLead = 0.5;
+    /// Blended, voxels → 2³: each 2³ cell passes over this fraction of its block's passage, placed
+    /// by a hash of the cell, so only that fraction of a passing block is drawn twice (1: all).
+    double lodVoxelRamp = 0.1;
     /// The low-pass folded into each point (px²: V_h, or V_s on the postfilter's sub-pixel grid).
     double pointPrefilterVariance = 1.0;
     /// Voxels whose projected spacing h·f/z is under this many pixels are drawn as points by
@@ -131,7 +133,7 @@ private:
         float dMin, dMax;               // distance range of its voxel centres (world)
         uint32_t voxels;                // active voxels
         int lodLevel;                   // 0: voxel by voxel; L ≥ 1: aggregates of (2^L)³ cells
-        float lodFine;                  // blend: weight of level lodLevel − 1 (0: level lodLevel alone)
+        float lodFine;                  // blended: 1 − t, t the passage to lodLevel from lodLevel − 1 (0: lodLevel alone)
     };
     void collectBlocks();
     bool visible(const Block& b) const;
