@@ -179,9 +179,9 @@ void VoxelStream::lodLevel(Block& b) const {
     }
     // Blended: the block passes from level k − 1 to level k while x = g(ℓ) goes from k to k + 1,
     // with g(ℓ) = ℓ up to ℓ = 1.5 and ℓ + lodLead from ℓ = 2.5 on (linear between, so g is
-    // monotone and the passages do not overlap): voxels → 2³ over ℓ ∈ [1, 1.83) (with the default
-    // lead ½: never coarser than the switching rule), 2³ → 4³ over [1.83, 2.5), 4³ → 8³ over
-    // [2.5, 3.5) (centred on the switch).
+    // monotone and the passages do not overlap). With the default lead 1: voxels → 2³ over
+    // ℓ ∈ [1, 1.75) (never coarser than the switching rule), 2³ → 4³ over [1.75, 2.25), 4³ → 8³
+    // over [2.25, 3) (all 8³ where they become admissible).
     const double x = ell + options_.lodLead * std::clamp(ell - 1.5, 0.0, 1.0);
     if (!(x >= 1.0)) return;
     if (x >= 4.0) {
