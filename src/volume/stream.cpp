@@ -261,13 +261,14 @@ float cellRank(const openvdb::Coord& cell, int level) {
 }  // namespace
 
 // A block between two levels (lodFine > 0) passes from level k − 1 to level k cell by cell: each
-// cell of level k has a coarse weight w_c that rises from 0 to 1 as the block's weight t = 1 −
-// lodFine does, over its own stretch of t (voxels → 2³: a fraction lodVoxelRamp of it, placed by the cell's
-// rank; between aggregates all of it), and is drawn at level k with its optical depth scaled by w_c and as its level-(k − 1)
-// children (or voxels) scaled by 1 − w_c. Optical depth is linear in σ, so each cell keeps its
-// energy exactly; the weights follow the camera continuously, so nothing pops; and only the cells
-// inside their stretch are drawn twice. The level with the larger weight carries the voxel counts
-// (members), the other 0: each voxel is counted once.
+// cell of level k has a coarse weight w_c that rises from 0 to 1 as the block's weight
+// t = 1 − lodFine does, over its own stretch of t (voxels → 2³: a fraction lodVoxelRamp of it,
+// placed by the cell's rank; between aggregates all of it), and is drawn at level k with its
+// optical depth scaled by w_c and as its level-(k − 1) children (or voxels) scaled by 1 − w_c.
+// Optical depth is linear in σ, so each cell keeps its energy exactly; the weights follow the
+// camera continuously, so nothing pops; and only the cells inside their stretch are drawn twice.
+// The level with the larger weight carries the voxel counts (members), the other 0: each voxel
+// is counted once.
 void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const {
     if (b.lodLevel == 0) return extractVoxels(b, nullptr, out);
     std::array<CellMoments, 64> acc{};  // cells ≤ (8/2)³

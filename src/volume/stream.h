@@ -13,9 +13,12 @@
 // (and under the point threshold, so every one of them would be a point anyway) is
 // released as aggregates of 2³, 4³ or 8³ voxels instead: one record per cell that
 // carries the cell's total optical-depth mass Σσ_k and σ-weighted colour, sits at the
-// σ-weighted centroid, and adds the projected second moment of its voxels about that
-// centroid to the point filter's variance (`spread`). Energy is kept exactly; what an
-// aggregate loses is the ordering of its own voxels in depth (measured in docs/fidelity.md).
+// σ-weighted centroid, and adds to the point filter's variance (`spread`) the projected second
+// moment of its voxels about that centroid beyond a full cell's own. A block passes from one
+// level to the next gradually as the camera moves, drawn at both with each cell's optical depth
+// split between them (StreamOptions::lodBlend), so a zoom does not pop. Energy is kept exactly;
+// what an aggregate loses is the ordering of its own voxels in depth (measured in
+// docs/fidelity.md, docs/animation.md).
 #pragma once
 #include <functional>
 #include <glm/glm.hpp>
@@ -35,11 +38,12 @@ class EmissionSource;  // volume/emission.h
 struct VoxelBatch {
     std::vector<glm::vec3> viewPos;  ///< voxel centre in view space (eye at origin, +z forward)
     std::vector<float> distance;     ///< |viewPos|, world units
-    std::vector<float> sigma;        ///< extinction per voxel length (σ_k·h)
+    std::vector<float> sigma;        ///< extinction per voxel length (σ_k·h; × its weight when blended)
     std::vector<glm::vec3> color;    ///< emitted colour c_k (σ-weighted mean for an aggregate)
-    std::vector<float> spread;       ///< aggregate: projected second moment about the centroid,
-                                     ///< isotropic (trace/2), px²; 0 for a single voxel
-    std::vector<uint32_t> members;   ///< voxels the record stands for (1, or an aggregate's count)
+    std::vector<float> spread;       ///< aggregate: projected second moment about the centroid
+                                     ///< beyond a full cell's, isotropic (trace/2), px²; 0 for a voxel
+    std::vector<uint32_t> members;   ///< voxels the record stands for (1, or an aggregate's count;
+                                     ///< 0 for the lighter of a blended block's two levels)
     int64_t slabBegin = 0;           ///< first slab of the window: slab = floor(distance / (h·slabThickness))
     int64_t slabEnd = 0;             ///< one past the last slab
     size_t size() const { return viewPos.size(); }
