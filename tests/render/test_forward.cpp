@@ -543,6 +543,29 @@ TEST(Forward, ImagesDoNotDependOnThreadCount) {
     }
 }
 
+// The same with the level of detail in its passages (voxels → 2³ at distance 2, aggregate levels
+// further out): blended blocks, hashed cell ramps and split weights are per block, so the image is
+// bit-identical for 1 and 2 threads.
+TEST(Forward, LevelOfDetailImagesDoNotDependOnThreadCount) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    for (const double distance : {2.0, 3.0, 5.0, 8.0, 12.0}) {
+        RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        Image one, two;
+        RenderStats st;
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+            one = renderWith(marschnerLobb(), tf, s, &st);
+        }
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+            two = renderWith(marschnerLobb(), tf, s);
+        }
+        EXPECT_GT(st.lodAggregates, 0u) << distance;
+        ASSERT_EQ(one.pixels.size(), two.pixels.size());
+        for (size_t i = 0; i < one.pixels.size(); ++i) ASSERT_EQ(one.pixels[i], two.pixels[i]) << distance << " pixel " << i;
+    }
+}
+
 // The compositor holds only the pixels the volume's kernels can reach (RenderSettings::
 // cropToVolume): a far view composites a small rectangle instead of the whole image. The
 // oracle is the whole-image render: every mode and filter order, the volume centred, off to
