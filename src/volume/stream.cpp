@@ -75,7 +75,7 @@ void VoxelStream::collectBlocks() {
     std::vector<Block> all;
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
         if (leaf->onVoxelCount() == 0) continue;
-        all.push_back({leaf->origin(), kBlockDim, &*leaf, 0.f, 0.f, 0.f, uint32_t(leaf->onVoxelCount()), 0});
+        all.push_back({leaf->origin(), kBlockDim, &*leaf, 0.f, 0.f, 0.f, uint32_t(leaf->onVoxelCount()), 0, 0.f});
     }
     // Active tiles (values above leaf level): split into virtual 8³ blocks.
     auto it = tree.cbeginValueOn();
@@ -87,7 +87,7 @@ void VoxelStream::collectBlocks() {
             for (int y = box.min().y(); y <= box.max().y(); y += kBlockDim)
                 for (int z = box.min().z(); z <= box.max().z(); z += kBlockDim)
                     all.push_back({openvdb::Coord(x, y, z), kBlockDim, nullptr, *it, 0.f, 0.f,
-                                   uint32_t(kBlockDim * kBlockDim * kBlockDim), 0});
+                                   uint32_t(kBlockDim * kBlockDim * kBlockDim), 0, 0.f});
     }
     // Distance bounds of voxel centres: the block's bounding sphere around its centre.
     const double halfDiagonal = blockHalfDiagonal_;
@@ -104,7 +104,7 @@ void VoxelStream::collectBlocks() {
             counts_.frustum += b.voxels;
             continue;
         }
-        b.lodLevel = lodLevel(b);
+        lodLevel(b);
         blocks_.push_back(b);
     }
     // Front to back by nearest distance; ties broken by position so the order is total.
@@ -156,26 +156,40 @@ void VoxelStream::screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1)
     y1 = int(std::clamp(std::ceil(hiy + m), 0.0, double(camera_.height() - 1)));
 }
 
-int VoxelStream::lodLevel(const Block& b) const {
-    if (!(options_.lodCellPx > 0.0) || !(options_.pointBelowPx > 0.0)) return 0;
+void VoxelStream::lodLevel(Block& b) const {
+    b.lodLevel = 0, b.lodFine = 0.f;
+    if (!(options_.lodCellPx > 0.0) || !(options_.pointBelowPx > 0.0)) return;
     const glm::dvec3 centreIdx = glm::dvec3(b.origin.x(), b.origin.y(), b.origin.z()) + 0.5 * (b.dim - 1);
     const glm::dvec3 c(indexToView_ * glm::dvec4(centreIdx, 1.0));
     const double zNear = c.z - blockHalfDiagonal_;  // nearest voxel centre's depth, bounded
-    if (!(zNear > 0.0)) return 0;
+    if (!(zNear > 0.0)) return;
     // The block's largest projected voxel spacing (the longest voxel axis: as the projection decides).
     const double spacingPx = largestAxis_ * camera_.focal() / zNear;
-    if (!(spacingPx < options_.pointBelowPx)) return 0;     // some voxel may be a splat
-    // A cell of n = 2^L voxels per side, uniform, adds the spread s²·(n² − 1)/12 px² per axis
-    // (s the projected spacing): at most kLodMaxSpreadRatio of the points' own filter variance.
+    if (!(spacingPx < options_.pointBelowPx)) return;     // some voxel may be a splat
+    // The admissible level ℓ, continuous: a cell of n = 2^ℓ voxels per side projects to n·s px (at
+    // most lodCellPx) and, uniform, would add the spread s²·(n² − 1)/12 px² per axis (s the projected
+    // spacing), at most kLodMaxSpreadRatio of the points' own filter variance.
     const double filter = pointFilterVariance(spacingPx, options_.pointPrefilterVariance);
-    int level = 0;
-    while (level < 3) {
-        const double n = double(2 << level);
-        const double spread = spacingPx * spacingPx * (n * n - 1.0) / 12.0;
-        if (n * spacingPx > options_.lodCellPx || spread > kLodMaxSpreadRatio * filter) break;
-        ++level;
+    const double bySize = std::log2(options_.lodCellPx / spacingPx);
+    const double bySpread = 0.5 * std::log2(1.0 + 12.0 * kLodMaxSpreadRatio * filter / (spacingPx * spacingPx));
+    const double ell = std::min(bySize, bySpread);
+    if (!options_.lodBlend) {  // the level switches at once where it becomes admissible
+        if (ell >= 1.0) b.lodLevel = int(std::min(std::floor(ell), 3.0));
+        return;
     }
-    return level;
+    // Blended: the block passes from level k − 1 to level k while x = g(ℓ) goes from k to k + 1,
+    // with g(ℓ) = ℓ up to ℓ = 1.5 and ℓ + lodLead from ℓ = 2.5 on (linear between, so g is
+    // monotone and the passages do not overlap). With the default lead 1: voxels → 2³ over
+    // ℓ ∈ [1, 1.75) (never coarser than the switching rule), 2³ → 4³ over [1.75, 2.25), 4³ → 8³
+    // over [2.25, 3) (all 8³ where they become admissible).
+    const double x = ell + options_.lodLead * std::clamp(ell - 1.5, 0.0, 1.0);
+    if (!(x >= 1.0)) return;
+    if (x >= 4.0) {
+        b.lodLevel = 3;
+        return;
+    }
+    b.lodLevel = int(std::floor(x));
+    b.lodFine = float(1.0 - (x - double(b.lodLevel)));
 }
 
 namespace {
@@ -208,44 +222,129 @@ private:
 }  // namespace
 
 /// Calls fn(local index (0..dim−1 per axis), classification) for every active voxel of the
-/// block: the table's, then shaded (VoxelShader, the same factors the reference reads) when
-/// shading is on. Shading here, in the parallel extraction, costs only the voxels drawn.
-template <typename Fn>
-void VoxelStream::forEachActive(const Block& b, Fn&& fn) const {
+/// block that keep(x, y, z) admits (the others are not classified): the table's, then shaded
+/// (VoxelShader, the same factors the reference reads) when shading is on. Shading here, in the
+/// parallel extraction, costs only the voxels drawn.
+template <typename Keep, typename Fn>
+void VoxelStream::forEachActive(const Block& b, Keep&& keep, Fn&& fn) const {
     VoxelClassifier classifyAt(volume_, table_, shader_, emission_);  // per block: blocks run on any thread
     const auto classify = [&](openvdb::Index n, float value) {
         return classifyAt(b.leaf, n, b.origin.offsetBy(int(n >> 6), int((n >> 3) & 7), int(n & 7)), value);
     };
+    const auto visit = [&](openvdb::Index n, float value) {
+        const int x = int(n >> 6), y = int((n >> 3) & 7), z = int(n & 7);
+        if (keep(x, y, z)) fn(x, y, z, classify(n, value));
+    };
     if (b.leaf) {
         const float* values = b.leaf->buffer().data();
         if (b.voxels == openvdb::FloatTree::LeafNodeType::SIZE) {  // dense leaf: no mask walk
-            for (openvdb::Index n = 0; n < openvdb::FloatTree::LeafNodeType::SIZE; ++n)
-                fn(int(n >> 6), int((n >> 3) & 7), int(n & 7), classify(n, values[n]));
+            for (openvdb::Index n = 0; n < openvdb::FloatTree::LeafNodeType::SIZE; ++n) visit(n, values[n]);
             return;
         }
-        for (auto it = b.leaf->getValueMask().beginOn(); it; ++it) {
-            const openvdb::Index n = it.pos();  // x·64 + y·8 + z
-            fn(int(n >> 6), int((n >> 3) & 7), int(n & 7), classify(n, values[n]));
-        }
+        for (auto it = b.leaf->getValueMask().beginOn(); it; ++it) visit(it.pos(), values[it.pos()]);  // n = x·64 + y·8 + z
     } else {
-        for (int x = 0; x < b.dim; ++x)
-            for (int y = 0; y < b.dim; ++y)
-                for (int z = 0; z < b.dim; ++z) fn(x, y, z, classify(openvdb::Index((x << 6) | (y << 3) | z), b.tileValue));
+        for (openvdb::Index n = 0; n < openvdb::FloatTree::LeafNodeType::SIZE; ++n) visit(n, b.tileValue);
     }
 }
 
-void VoxelStream::extract(const Block& b, VoxelBatch& out) const {
-    if (b.lodLevel > 0) return extractAggregates(b, out);
+namespace {
+/// A cell's own place in a block's blend, in [0, 1): a hash of its global cell coordinates and
+/// level (splitmix64's finaliser), so it does not depend on the camera, the block order or the thread.
+float cellRank(const openvdb::Coord& cell, int level) {
+    uint64_t h = (uint64_t(uint32_t(cell.x())) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(uint32_t(cell.y())) * 0xC2B2AE3D27D4EB4Full) ^
+                 (uint64_t(uint32_t(cell.z())) * 0x165667B19E3779F9ull) ^ uint64_t(level);
+    h ^= h >> 30, h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 27, h *= 0x94D049BB133111EBull;
+    h ^= h >> 31;
+    return float(h >> 40) * (1.f / float(1 << 24));
+}
+}  // namespace
+
+// A block between two levels (lodFine > 0) passes from level k − 1 to level k cell by cell: each
+// cell of level k has a coarse weight w_c that rises from 0 to 1 as the block's weight
+// t = 1 − lodFine does, over its own stretch of t (voxels → 2³: a fraction lodVoxelRamp of it,
+// placed by the cell's rank; between aggregates all of it), and is drawn at level k with its
+// optical depth scaled by w_c and as its level-(k − 1) children (or voxels) scaled by 1 − w_c.
+// Optical depth is linear in σ, so each cell keeps its energy exactly; the weights follow the
+// camera continuously, so nothing pops; and only the cells inside their stretch are drawn twice.
+// The level with the larger weight carries the voxel counts (members), the other 0: each voxel
+// is counted once.
+void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const {
+    if (b.lodLevel == 0) return extractVoxels(b, nullptr, out);
+    std::array<CellMoments, 64> acc{};  // cells ≤ (8/2)³
+    if (!(b.lodFine > 0.f)) {
+        cellMoments(b, b.lodLevel, acc.data());
+        return emitCells(b, b.lodLevel, acc.data(), nullptr, false, out, counts);
+    }
+    const int k = b.lodLevel, parents = kBlockDim >> k;
+    // From the voxels, cell by cell (drawing a block twice would cost its voxels again); between
+    // aggregates, every cell at once (the finer level costs 8× fewer records than the voxels).
+    const double t = 1.0 - double(b.lodFine), ramp = k == 1 ? std::clamp(options_.lodVoxelRamp, 1e-3, 1.0) : 1.0;
+    std::array<float, 64> coarse{};  // per level-k cell: its weight w_c at level k (1 − w_c at level k − 1)
+    for (int cx = 0; cx < parents; ++cx)
+        for (int cy = 0; cy < parents; ++cy)
+            for (int cz = 0; cz < parents; ++cz) {
+                const size_t i = size_t((cx * parents + cy) * parents + cz);
+                const openvdb::Coord cell((b.origin.x() >> k) + cx, (b.origin.y() >> k) + cy, (b.origin.z() >> k) + cz);
+                const double w = ramp >= 1.0 ? t : std::clamp((t - double(cellRank(cell, k)) * (1.0 - ramp)) / ramp, 0.0, 1.0);
+                coarse[i] = float(w);
+            }
+    if (k == 1) {
+        extractVoxels(b, coarse.data(), out);
+    } else {
+        // Level k − 1's moments, emitted for the cells' fine weights, then level k's from them (each
+        // parent the sum of its 8 children, moved from the child's centre to the parent's: d + o).
+        const int level = k - 1, cells = kBlockDim >> level;
+        const float childSide = float(1 << level);
+        cellMoments(b, level, acc.data());
+        std::array<float, 64> parentWeight{};
+        for (int cx = 0; cx < cells; ++cx)
+            for (int cy = 0; cy < cells; ++cy)
+                for (int cz = 0; cz < cells; ++cz)
+                    parentWeight[size_t((cx * cells + cy) * cells + cz)] =
+                        coarse[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
+        emitCells(b, level, acc.data(), parentWeight.data(), true, out, counts);
+        std::array<CellMoments, 64> up{};
+        for (int cx = 0; cx < cells; ++cx)
+            for (int cy = 0; cy < cells; ++cy)
+                for (int cz = 0; cz < cells; ++cz) {
+                    const CellMoments& a = acc[size_t((cx * cells + cy) * cells + cz)];
+                    if (a.n == 0 && !(a.m > 0.f)) continue;
+                    CellMoments& p = up[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
+                    const glm::vec3 o = (glm::vec3(float(cx & 1), float(cy & 1), float(cz & 1)) - 0.5f) * childSide;
+                    p.m += a.m;
+                    p.emission += a.emission;
+                    p.first += a.first + a.m * o;
+                    p.xx += a.xx + 2.f * o.x * a.first.x + a.m * o.x * o.x;
+                    p.yy += a.yy + 2.f * o.y * a.first.y + a.m * o.y * o.y;
+                    p.zz += a.zz + 2.f * o.z * a.first.z + a.m * o.z * o.z;
+                    p.xy += a.xy + o.x * a.first.y + o.y * a.first.x + a.m * o.x * o.y;
+                    p.xz += a.xz + o.x * a.first.z + o.z * a.first.x + a.m * o.x * o.z;
+                    p.yz += a.yz + o.y * a.first.z + o.z * a.first.y + a.m * o.y * o.z;
+                    p.n += a.n;
+                }
+        acc = up;
+    }
+    if (k == 1) cellMoments(b, 1, acc.data());
+    emitCells(b, k, acc.data(), coarse.data(), false, out, counts);
+}
+
+// coarse: per level-1 cell (x>>1, y>>1, z>>1) its weight w_c at level 1; the voxels take 1 − w_c
+// (none drawn, nor classified, where w_c = 1) and carry the counts where w_c < ½. nullptr: w_c = 0.
+void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const {
     const glm::dvec3 origin(b.origin.x(), b.origin.y(), b.origin.z());
-    forEachActive(b, [&](int x, int y, int z, const Classified& cls) {
+    const auto wc = [&](int x, int y, int z) { return coarse ? coarse[size_t(((x >> 1) * 4 + (y >> 1)) * 4 + (z >> 1))] : 0.f; };
+    forEachActive(b, [&](int x, int y, int z) { return wc(x, y, z) < 1.f; },
+                  [&](int x, int y, int z, const Classified& cls) {
         if (!(cls.sigma > 0.f)) return;
+        const float c = wc(x, y, z), w = 1.f - c;
         const glm::dvec3 v(indexToView_ * glm::dvec4(origin + glm::dvec3(x, y, z), 1.0));
         out.viewPos.emplace_back(v);
         out.distance.push_back(float(glm::length(v)));
-        out.sigma.push_back(cls.sigma);
+        out.sigma.push_back(w == 1.f ? cls.sigma : cls.sigma * w);
         out.color.push_back(cls.color);
         out.spread.push_back(0.f);
-        out.members.push_back(1);
+        out.members.push_back(c < 0.5f ? 1 : 0);
     });
 }
 
@@ -288,11 +387,10 @@ void forEachRow(const auto& b, const Volume& volume, const ClassificationTable& 
 // ≤ 3.5 voxels) so the float sums do not cancel, row by row: along a row of the block (z) the
 // offsets dx and dy are constant, so the row's Σσ, Σσ·dz and Σσ·dz² give every moment
 // (Σσ·dx·dz = dx·Σσ·dz, Σσ·dx² = dx²·Σσ, ...): three sums per voxel instead of ten.
-void VoxelStream::extractAggregates(const Block& b, VoxelBatch& out) const {
+void VoxelStream::cellMoments(const Block& b, int level, CellMoments* acc) const {
     using Moments = CellMoments;
-    const int level = b.lodLevel, side = 1 << level, cells = b.dim >> level;
+    const int side = 1 << level, cells = b.dim >> level;
     const float half = 0.5f * float(side - 1);
-    std::array<Moments, 64> acc{};  // cells ≤ (8/2)³
     // Leaves without shading or emission: the vectorised sums (leaf_moments.h; 2–4× the scalar rows).
     const bool vectorised = level >= 1 && b.leaf && !shader_ && !emission_ && table_.entries() &&
                             options_.vectorLeafMoments && leafMomentsSupported();
@@ -300,7 +398,7 @@ void VoxelStream::extractAggregates(const Block& b, VoxelBatch& out) const {
         const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE;
         std::array<uint64_t, 8> words;
         for (int x = 0; x < 8; ++x) words[size_t(x)] = b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));
-        leafMoments(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, level, acc.data());
+        leafMoments(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, level, acc);
     } else forEachRow(b, volume_, table_, shader_, emission_, [&](int x, int y, const std::array<float, kBlockDim>& sigma, const std::array<glm::vec3, kBlockDim>& color) {
         const float dx = float(x & (side - 1)) - half, dy = float(y & (side - 1)) - half;
         Moments* row = &acc[size_t(((x >> level) * cells + (y >> level)) * cells)];
@@ -327,6 +425,16 @@ void VoxelStream::extractAggregates(const Block& b, VoxelBatch& out) const {
             a.n += n;
         }
     });
+}
+
+// coarse: per cell of this level (fineSide: of the level above), the coarse weight w_c; the cell
+// takes w_c (fineSide: 1 − w_c; nothing where that is 0) and carries its count where w_c ≥ ½
+// (fineSide: < ½). nullptr: weight 1, counted.
+void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, const float* coarse, bool fineSide,
+                            VoxelBatch& out, StreamCounts& counts) const {
+    using Moments = CellMoments;
+    const int side = 1 << level, cells = b.dim >> level;
+    const float half = 0.5f * float(side - 1);
     const glm::dmat3 toView(indexToView_);  // linear part: index offsets → view offsets
     const double f = camera_.focal();
     for (int cx = 0; cx < cells; ++cx)
@@ -334,6 +442,10 @@ void VoxelStream::extractAggregates(const Block& b, VoxelBatch& out) const {
             for (int cz = 0; cz < cells; ++cz) {
                 const Moments& a = acc[size_t((cx * cells + cy) * cells + cz)];
                 if (!(a.m > 0.f)) continue;
+                const float c = coarse ? coarse[size_t((cx * cells + cy) * cells + cz)] : 1.f;
+                const float weight = fineSide ? 1.f - c : c;
+                const bool counted = fineSide ? c < 0.5f : c >= 0.5f;
+                if (!(weight > 0.f)) continue;
                 const glm::dvec3 mu = glm::dvec3(a.first) / double(a.m);
                 const glm::dvec3 centreIdx = glm::dvec3(b.origin.x() + cx * side, b.origin.y() + cy * side,
                                                         b.origin.z() + cz * side) + double(half) + mu;
@@ -352,10 +464,17 @@ void VoxelStream::extractAggregates(const Block& b, VoxelBatch& out) const {
                 const double spread = 0.5 * (glm::dot(ux, cov * ux) + glm::dot(uy, cov * uy));
                 out.viewPos.emplace_back(v);
                 out.distance.push_back(float(glm::length(v)));
-                out.sigma.push_back(a.m);
+                out.sigma.push_back(weight == 1.f ? a.m : a.m * weight);
                 out.color.push_back(a.emission / a.m);
-                out.spread.push_back(float(std::max(spread, 0.0)));
-                out.members.push_back(a.n);
+                // Only what exceeds a full cell's own second moment (s²·(n² − 1)/12 per index axis)
+                // is added: the cells' lattice already spreads a full cell's mass over the cell, as
+                // the voxels' lattice does a voxel's (a uniform region of cells is the same quadrature
+                // of the same field as its voxels, one level coarser). Adding it again blurred every
+                // surface by a cell (docs/animation.md, session 5).
+                const double full = (double(side) * side - 1.0) / 12.0 * 0.5 * (glm::dot(ux, ux) + glm::dot(uy, uy));
+                out.spread.push_back(float(std::max(spread - full, 0.0)));
+                out.members.push_back(counted ? a.n : 0);
+                if (counted) ++counts.aggregates, counts.aggregatedVoxels += a.n;
             }
 }
 
@@ -441,6 +560,7 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
         const size_t count = nextBlock_ - first;
         if (extracted_.size() < count) extracted_.resize(count);
         skipped_.assign(count, 0);
+        blockCounts_.assign(count, StreamCounts{});
         tbb::parallel_for(tbb::blocked_range<size_t>(first, nextBlock_, 16), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 const Block& b = blocks_[i];
@@ -454,16 +574,13 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                         continue;
                     }
                 }
-                extract(b, e);
+                extract(b, e, blockCounts_[i - first]);
             }
         });
         for (size_t i = first; i < nextBlock_; ++i) {
             if (skipped_[i - first]) counts_.occluded += blocks_[i].voxels;
-            if (blocks_[i].lodLevel > 0) {
-                const VoxelBatch& e = extracted_[i - first];
-                counts_.aggregates += e.size();
-                for (uint32_t n : e.members) counts_.aggregatedVoxels += n;
-            }
+            counts_.aggregates += blockCounts_[i - first].aggregates;
+            counts_.aggregatedVoxels += blockCounts_[i - first].aggregatedVoxels;
         }
         // Release the voxels inside the window (pending first, then the new blocks in order);
         // the rest stays pending, in the same order.

@@ -13,9 +13,12 @@
 // (and under the point threshold, so every one of them would be a point anyway) is
 // released as aggregates of 2³, 4³ or 8³ voxels instead: one record per cell that
 // carries the cell's total optical-depth mass Σσ_k and σ-weighted colour, sits at the
-// σ-weighted centroid, and adds the projected second moment of its voxels about that
-// centroid to the point filter's variance (`spread`). Energy is kept exactly; what an
-// aggregate loses is the ordering of its own voxels in depth (measured in docs/fidelity.md).
+// σ-weighted centroid, and adds to the point filter's variance (`spread`) the projected second
+// moment of its voxels about that centroid beyond a full cell's own. A block passes from one
+// level to the next gradually as the camera moves, drawn at both with each cell's optical depth
+// split between them (StreamOptions::lodBlend), so a zoom does not pop. Energy is kept exactly;
+// what an aggregate loses is the ordering of its own voxels in depth (measured in
+// docs/fidelity.md, docs/animation.md).
 #pragma once
 #include <functional>
 #include <glm/glm.hpp>
@@ -23,6 +26,7 @@
 
 #include "camera/camera.h"
 #include "volume/grid.h"
+#include "volume/leaf_moments.h"
 #include "volume/transfer_function.h"
 
 namespace vdbsplat {
@@ -34,11 +38,12 @@ class EmissionSource;  // volume/emission.h
 struct VoxelBatch {
     std::vector<glm::vec3> viewPos;  ///< voxel centre in view space (eye at origin, +z forward)
     std::vector<float> distance;     ///< |viewPos|, world units
-    std::vector<float> sigma;        ///< extinction per voxel length (σ_k·h)
+    std::vector<float> sigma;        ///< extinction per voxel length (σ_k·h; × its weight when blended)
     std::vector<glm::vec3> color;    ///< emitted colour c_k (σ-weighted mean for an aggregate)
-    std::vector<float> spread;       ///< aggregate: projected second moment about the centroid,
-                                     ///< isotropic (trace/2), px²; 0 for a single voxel
-    std::vector<uint32_t> members;   ///< voxels the record stands for (1, or an aggregate's count)
+    std::vector<float> spread;       ///< aggregate: projected second moment about the centroid
+                                     ///< beyond a full cell's, isotropic (trace/2), px²; 0 for a voxel
+    std::vector<uint32_t> members;   ///< voxels the record stands for (1, or an aggregate's count;
+                                     ///< 0 for the lighter of a blended block's two levels)
     int64_t slabBegin = 0;           ///< first slab of the window: slab = floor(distance / (h·slabThickness))
     int64_t slabEnd = 0;             ///< one past the last slab
     size_t size() const { return viewPos.size(); }
@@ -71,6 +76,20 @@ struct StreamOptions {
     /// only while the spread a cell adds stays within kLodMaxSpreadRatio of the variance of the
     /// points it replaces (pointFilterVariance with the pass's low-pass below).
     double lodCellPx = 1.0;
+    /// Level of detail, blended (docs/performance.md, "Level of detail"): a block passes from one
+    /// level to the next continuously as the camera moves, drawn at both with its optical depth
+    /// split between them, so no cell pops during a zoom; false: the level switches at once where
+    /// it becomes admissible (the rule before session 5; for tests and measurement).
+    bool lodBlend = true;
+    /// Blended: how many levels earlier than the switching rule 4³ and 8³ cells come in (1: a block
+    /// is all 8³ cells where they become admissible; 2³ cells always come in only once admissible).
+    /// Aggregates that add only the spread beyond a full cell's own (emitCells) no longer blur by
+    /// the spread the admissibility rule limits; measured, 1 is better than ½ or ¾ in every far
+    /// cell of the fidelity table and in both zoom animations (docs/animation.md, session 5).
+    double lodLead = 1.0;
+    /// Blended, voxels → 2³: each 2³ cell passes over this fraction of its block's passage, placed
+    /// by a hash of the cell, so only that fraction of a passing block is drawn twice (1: all).
+    double lodVoxelRamp = 0.1;
     /// The low-pass folded into each point (px²: V_h, or V_s on the postfilter's sub-pixel grid).
     double pointPrefilterVariance = 1.0;
     /// Voxels whose projected spacing h·f/z is under this many pixels are drawn as points by
@@ -121,14 +140,18 @@ private:
         float dMin, dMax;               // distance range of its voxel centres (world)
         uint32_t voxels;                // active voxels
         int lodLevel;                   // 0: voxel by voxel; L ≥ 1: aggregates of (2^L)³ cells
+        float lodFine;                  // blended: 1 − t, t the passage to lodLevel from lodLevel − 1 (0: lodLevel alone)
     };
     void collectBlocks();
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
-    int lodLevel(const Block& b) const;
-    void extract(const Block& b, VoxelBatch& out) const;
-    void extractAggregates(const Block& b, VoxelBatch& out) const;
-    template <typename Fn> void forEachActive(const Block& b, Fn&& fn) const;
+    void lodLevel(Block& b) const;  // sets b.lodLevel and b.lodFine
+    void extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const;  // counts: aggregates only
+    void extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const;
+    void cellMoments(const Block& b, int level, CellMoments* acc) const;
+    void emitCells(const Block& b, int level, const CellMoments* acc, const float* coarse, bool fineSide,
+                   VoxelBatch& out, StreamCounts& counts) const;
+    template <typename Keep, typename Fn> void forEachActive(const Block& b, Keep&& keep, Fn&& fn) const;
     void adaptWindow(size_t released);  // the next window's slab count from this one's size
     void release(size_t blocks, float limit, VoxelBatch& batch);  // pending + extracted → batch, pending
 
@@ -145,6 +168,7 @@ private:
     VoxelBatch pendingNext_;      // the pending voxels a window keeps (swapped with pending_)
     std::vector<VoxelBatch> extracted_;  // per activated block of the window (reused)
     std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
+    std::vector<StreamCounts> blockCounts_;  // per activated block: its aggregates
     int64_t nextSlab_ = 0;
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
     glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)

@@ -368,7 +368,9 @@ TEST(Forward, ZoomThroughTheSwitchDoesNotPop) {
 // ---------------------------------------------------------------------------------------------
 // Level of detail (DESIGN §8.2): aggregates keep the energy, the image, and the zoom smooth
 
-// Far away the aggregates replace most points, and the image stays what the voxels give.
+// Far away the aggregates replace most points, and the image stays what the voxels give: close to
+// it (LOD vs none; measured 52.3 and 52.5 dB, 73 dB before session 5, whose aggregates also added
+// a full cell's spread), and against the reference no worse (measured 3.9 and 6.9 dB better).
 TEST(Forward, LevelOfDetailKeepsTheFarImage) {
     const TransferFunction tf = TransferFunction::preset("grey");
     for (const double distance : {8.0, 4.0}) {
@@ -377,22 +379,30 @@ TEST(Forward, LevelOfDetailKeepsTheFarImage) {
         const Image a = renderWith(marschnerLobb(), tf, s, &on);
         s.lodPx = 0.0;
         const Image b = renderWith(marschnerLobb(), tf, s, &off);
+        s.mode = RenderMode::Reference;
+        const Image& reference = referenceOf("marschner-lobb", marschnerLobb(), tf, s);
         const double psnr = compareImages(a, b).psnr;
-        std::printf("  distance %.0f: %llu points for %llu (%llu aggregates of %llu voxels), LOD vs none %.1f dB\n",
+        const double lodToRef = compareImages(a, reference).psnr, noneToRef = compareImages(b, reference).psnr;
+        std::printf("  distance %.0f: %llu points for %llu (%llu aggregates of %llu voxels), LOD vs none %.1f dB; "
+                    "vs reference %.2f (LOD) %.2f (none) dB\n",
                     distance, (unsigned long long)on.points, (unsigned long long)off.points,
-                    (unsigned long long)on.lodAggregates, (unsigned long long)on.lodVoxels, psnr);
+                    (unsigned long long)on.lodAggregates, (unsigned long long)on.lodVoxels, psnr, lodToRef, noneToRef);
         EXPECT_EQ(off.lodAggregates, 0u);
         EXPECT_GT(on.lodAggregates, 0u);
         EXPECT_LT(on.points * 4, off.points);   // it did aggregate
         EXPECT_EQ(on.culled, off.culled);       // and every voxel is still accounted for
-        EXPECT_GT(psnr, 60.0);
+        EXPECT_GT(psnr, 50.0);
+        EXPECT_GT(lodToRef, noneToRef - 0.1);
     }
 }
 
 // Energy: at low opacity the image's alpha is ≈ the deposited optical depth, which the aggregates
 // must keep exactly (total mass Σσ at the centroid). A lost or doubled voxel would show here.
+// The medium is thin enough (σ = 1e−4 per voxel, peak alpha 0.5 %) that alpha's own curvature,
+// α ≈ τ − τ²/2, stays under the bound: coarse cells deposit their τ less evenly than the voxels
+// (measured −6.1e−5; at σ = 1e−3 it is −4.8e−4, ten times the τ², where the energy is the same).
 TEST(Forward, LevelOfDetailKeepsTheEnergy) {
-    const TransferFunction tf = constantTf(0.001f);
+    const TransferFunction tf = constantTf(0.0001f);
     RenderSettings s = settingsFor(RenderMode::Hybrid, 6.0);
     RenderStats on;
     const Image a = renderWith(marschnerLobb(), tf, s, &on);
@@ -401,34 +411,45 @@ TEST(Forward, LevelOfDetailKeepsTheEnergy) {
     double sa = 0.0, sb = 0.0;
     for (size_t i = 0; i < a.pixels.size(); ++i) sa += a.pixels[i].w, sb += b.pixels[i].w;
     ASSERT_GT(on.lodAggregates, 0u);
-    EXPECT_NEAR(sa / sb, 1.0, 2e-4);
+    EXPECT_NEAR(sa / sb, 1.0, 1e-4);
 }
 
 // At a large image size the voxels of a far view project to about half a pixel (Engine 1024²,
 // --distance 8: 0.4–0.6 px): a 2³ cell then spans about a pixel. The default level of detail
-// still aggregates there (with --lod 1 it made no aggregate) and keeps the image: against
-// --lod 0 and, within 0.5 dB (measured 0.25), against the reference.
+// admits 2³ cells there (with --lod 1 it made no aggregate: the levels switching at once, 4× fewer
+// points); blended, the block is early in its passage from voxels to 2³ cells (some of them
+// aggregated). Both keep the image: close to --lod 0 (measured 68.2 dB blended, 53.6 switching)
+// and against the reference no worse than it by 0.5 dB (measured: 1.0 and 4.2 dB better).
 TEST(Forward, LevelOfDetailAggregatesHalfPixelVoxels) {
     const TransferFunction tf = TransferFunction::preset("grey");
     RenderSettings s = settingsFor(RenderMode::Hybrid, 2.0);  // 96²: Marschner–Lobb voxels at ≈ 0.55 px
-    RenderStats on, off;
+    RenderStats on, switching, off;
     const Image a = renderWith(marschnerLobb(), tf, s, &on);
+    s.stream.lodBlend = false;
+    const Image c = renderWith(marschnerLobb(), tf, s, &switching);
     s.lodPx = 0.0;
     const Image b = renderWith(marschnerLobb(), tf, s, &off);
     s.mode = RenderMode::Reference;
     const Image& reference = referenceOf("marschner-lobb", marschnerLobb(), tf, s);
-    const double between = compareImages(a, b).psnr;
+    const double between = compareImages(a, b).psnr, betweenSwitching = compareImages(c, b).psnr;
     const double lodToRef = compareImages(a, reference).psnr, noneToRef = compareImages(b, reference).psnr;
-    std::printf("  %llu points for %llu (%llu aggregates), LOD vs none %.1f dB; vs reference %.2f (LOD) %.2f (none) dB\n",
-                (unsigned long long)on.points, (unsigned long long)off.points, (unsigned long long)on.lodAggregates,
-                between, lodToRef, noneToRef);
-    EXPECT_LT(on.points * 4, off.points);
+    const double switchingToRef = compareImages(c, reference).psnr;
+    std::printf("  %llu points blended, %llu switching, for %llu (%llu and %llu aggregates), LOD vs none %.1f and "
+                "%.1f dB; vs reference %.2f (blended) %.2f (switching) %.2f (none) dB\n",
+                (unsigned long long)on.points, (unsigned long long)switching.points, (unsigned long long)off.points,
+                (unsigned long long)on.lodAggregates, (unsigned long long)switching.lodAggregates, between,
+                betweenSwitching, lodToRef, switchingToRef, noneToRef);
+    EXPECT_LT(switching.points * 4, off.points);
+    EXPECT_LT(on.points, off.points);
     EXPECT_GT(between, 60.0);
+    EXPECT_GT(betweenSwitching, 50.0);
     EXPECT_GT(lodToRef, noneToRef - 0.5);
+    EXPECT_GT(switchingToRef, noneToRef - 0.5);
 }
 
 // A zoom from far to near crosses the level changes (8³ → 4³ → 2³ → voxels) and then the point/splat
-// switch: every frame with LOD agrees with the frame without it, so no level change pops.
+// switch: every frame with LOD stays close to the frame without it. (Between frames, the level
+// changes themselves: ZoomStepsAcrossLevelChangesAreSmooth.)
 TEST(Forward, ZoomThroughTheLevelsDoesNotPop) {
     const TransferFunction tf = TransferFunction::preset("grey");
     constexpr int kFrames = 10;
@@ -448,7 +469,53 @@ TEST(Forward, ZoomThroughTheLevelsDoesNotPop) {
     }
     EXPECT_GT(firstMembers, 100.0);  // 8³ cells at the far end
     EXPECT_EQ(lastMembers, 1.0);     // no aggregates at the near end
-    EXPECT_GT(worst, 55.0);
+    EXPECT_GT(worst, 45.0);  // measured 48.1 (61 before session 5: aggregates with a full cell's spread)
+}
+
+// Level changes do not pop between frames (issue 10's flicker, docs/animation.md session 5): along
+// a zoom in steps of 3 % from 8³ cells to single voxels, the image change of each step with the
+// level of detail stays within a small margin of the change the same step gives without it
+// (mean |ΔI| over pixels and RGBA). With the levels switching at once (lodBlend off, the rule
+// before session 5) a block that changes level between two frames adds its whole change to one
+// step; the test checks that this is what it would catch. Measured: the largest excess, in units
+// of the step's own change, 0.24 blended and 1.21 switching.
+TEST(Forward, ZoomStepsAcrossLevelChangesAreSmooth) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    const auto meanDiff = [](const Image& a, const Image& b) {
+        double sum = 0.0;
+        for (size_t i = 0; i < a.pixels.size(); ++i) {
+            const glm::vec4 d = glm::abs(a.pixels[i] - b.pixels[i]);
+            sum += double(d.x + d.y + d.z + d.w);
+        }
+        return sum / double(4 * a.pixels.size());
+    };
+    struct Frame { Image blended, switching, none; };
+    const auto frameAt = [&](double distance) {
+        RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        Frame f;
+        f.blended = renderWith(marschnerLobb(), tf, s);
+        s.stream.lodBlend = false;
+        f.switching = renderWith(marschnerLobb(), tf, s);
+        s.lodPx = 0.0;
+        f.none = renderWith(marschnerLobb(), tf, s);
+        return f;
+    };
+    double worstBlended = 0.0, worstSwitching = 0.0;
+    Frame previous = frameAt(16.0);
+    for (double distance = 16.0 * 0.97; distance > 1.5; distance *= 0.97) {
+        Frame f = frameAt(distance);
+        const double none = meanDiff(f.none, previous.none);
+        // The excess over the step's own change, in units of it (a floor for nearly still frames).
+        const double floor = std::max(none, 1e-6);
+        const double blended = (meanDiff(f.blended, previous.blended) - none) / floor;
+        const double switching = (meanDiff(f.switching, previous.switching) - none) / floor;
+        worstBlended = std::max(worstBlended, blended), worstSwitching = std::max(worstSwitching, switching);
+        previous = std::move(f);
+    }
+    std::printf("  largest excess of a step's image change over the change without LOD: blended %.3f, switching %.3f\n",
+                worstBlended, worstSwitching);
+    EXPECT_LT(worstBlended, 0.5);
+    EXPECT_GT(worstSwitching, 2.0 * worstBlended);  // the test sees a pop where there is one
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -473,6 +540,29 @@ TEST(Forward, ImagesDoNotDependOnThreadCount) {
         ASSERT_EQ(one.pixels.size(), two.pixels.size());
         for (size_t i = 0; i < one.pixels.size(); ++i)
             ASSERT_EQ(one.pixels[i], two.pixels[i]) << toString(order) << " " << toString(mode) << " pixel " << i;
+    }
+}
+
+// The same with the level of detail in its passages (voxels → 2³ at distance 2, aggregate levels
+// further out): blended blocks, hashed cell ramps and split weights are per block, so the image is
+// bit-identical for 1 and 2 threads.
+TEST(Forward, LevelOfDetailImagesDoNotDependOnThreadCount) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    for (const double distance : {2.0, 3.0, 5.0, 8.0, 12.0}) {
+        RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        Image one, two;
+        RenderStats st;
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+            one = renderWith(marschnerLobb(), tf, s, &st);
+        }
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+            two = renderWith(marschnerLobb(), tf, s);
+        }
+        EXPECT_GT(st.lodAggregates, 0u) << distance;
+        ASSERT_EQ(one.pixels.size(), two.pixels.size());
+        for (size_t i = 0; i < one.pixels.size(); ++i) ASSERT_EQ(one.pixels[i], two.pixels[i]) << distance << " pixel " << i;
     }
 }
 

@@ -232,8 +232,9 @@ double psnr(RenderMode mode, double distance, FilterOrder order = FilterOrder::P
 
 // The checker box at 96²: without a low-pass (none) the image aliases and falls below hybrid,
 // EWA and Swan, which all band-limit, far away and framed; EWA and Swan stay within a fraction of
-// a dB of hybrid in the same (prefilter) order. Measured (dB): far hybrid 33.72, ewa 33.85,
-// swan 33.90, none 32.14; framed hybrid 35.95, ewa 35.96, swan 35.99, none 26.95. Far away the
+// a dB of hybrid in the same (prefilter) order. Measured (dB): far hybrid 34.43 (33.72 before
+// session 5's level of detail, which EWA and Swan, all splats, do not use), ewa 33.85, swan 33.90,
+// none 32.14; framed hybrid 35.95, ewa 35.96, swan 35.99, none 26.95. Far away the
 // nearest-pixel points of a dense volume sum to a box filter per pixel, which aliases less than
 // point sampling would: the gap is smaller there (docs/modes.md).
 TEST(Modes, NoneAliasesAndTheFilteredModesDoNot) {
@@ -242,8 +243,8 @@ TEST(Modes, NoneAliasesAndTheFilteredModesDoNot) {
         const double none = psnr(RenderMode::None, distance), ewa = psnr(RenderMode::Ewa, distance),
                      swan = psnr(RenderMode::Swan, distance);
         EXPECT_LT(none, hybrid - (distance > 1.0 ? 1.0 : 3.0)) << distance;
-        EXPECT_NEAR(ewa, hybrid, 0.5) << distance;
-        EXPECT_NEAR(swan, hybrid, 0.5) << distance;
+        EXPECT_NEAR(ewa, hybrid, 0.75) << distance;
+        EXPECT_NEAR(swan, hybrid, 0.75) << distance;
     }
 }
 
