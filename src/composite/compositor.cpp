@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "composite/opacity.h"
+#include "composite/point_raster.h"
 #include "composite/splat_raster.h"
 #include "footprint/kernel.h"
 
@@ -78,10 +79,13 @@ Entry* radixSort(Entry* a, Entry* scratch, size_t n, int bits) {
 }
 }  // namespace
 
-/// Optical depth and σ-weighted colour of the points of the current slab, per tile pixel.
+/// Optical depth and σ-weighted colour of the points of the current slab, per tile pixel
+/// (structure of arrays, 64-byte aligned: the point loop loads whole rows; point_raster.h).
 struct TileCompositor::SlabBuffer {
-    std::array<float, kTileSize * kTileSize> tau{};
-    std::array<glm::vec3, kTileSize * kTileSize> emission{};
+    alignas(64) std::array<float, kTileSize * kTileSize> tau{};
+    alignas(64) std::array<float, kTileSize * kTileSize> er{};
+    alignas(64) std::array<float, kTileSize * kTileSize> eg{};
+    alignas(64) std::array<float, kTileSize * kTileSize> eb{};
     bool dirty = false;
 };
 
@@ -189,8 +193,10 @@ void TileCompositor::sortWindow(std::span<const Primitive> prims) {
             const Primitive& p = prims[order_[k].index];
             TileRecord& q = records_[k];
             q.centre = p.centre;
-            q.shape = p.kind == PrimitiveKind::Point ? glm::vec3(p.variance, p.total, 0.f) : p.conic;
-            q.scale = p.scale, q.sin2Alpha = p.sin2Alpha;
+            const bool point = p.kind == PrimitiveKind::Point;
+            q.shape = point ? glm::vec3(p.pointInvVariance, p.total, p.pointNorm) : p.conic;
+            q.scale = point ? p.pointRadius2 : p.scale;
+            q.sin2Alpha = p.sin2Alpha;
             q.color = p.color;
             q.range = p.range;
             q.slab = uint32_t(std::clamp<int64_t>(p.slab - layout.slabBase, 0, std::numeric_limits<uint32_t>::max()));
@@ -309,10 +315,10 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
         for (int y = px.y0; y <= px.y1; ++y)
             for (int x = px.x0; x <= px.x1; ++x) {
                 const int i = px.local(x, y);
-                const float tau = slab.tau[size_t(i)];
-                if (tau > 0.f) px.over(i, tau, slab.emission[size_t(i)] / tau);
-                slab.tau[size_t(i)] = 0.f;
-                slab.emission[size_t(i)] = glm::vec3(0.f);
+                const size_t j = size_t(i);
+                const float tau = slab.tau[j];
+                if (tau > 0.f) px.over(i, tau, glm::vec3(slab.er[j], slab.eg[j], slab.eb[j]) / tau);
+                slab.tau[j] = 0.f, slab.er[j] = 0.f, slab.eg[j] = 0.f, slab.eb[j] = 0.f;
             }
         slab.dirty = false;
     };
@@ -356,18 +362,17 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
 }
 
 void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBuffer& slab) const {
-    const float variance = p.shape.x, total = p.shape.y;
-    const PointFootprint fp = rasterizePoint(pointFilter_, PixelCoord(p.centre), variance);
-    const int x0 = std::max(fp.x0, px.x0), x1 = std::min(fp.x0 + fp.nx - 1, px.x1);
-    const int y0 = std::max(fp.y0, px.y0), y1 = std::min(fp.y0 + fp.ny - 1, px.y1);
-    for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) {
-            const int i = px.local(x, y);
-            if (!px.live(i)) continue;
-            const float tau = total * fp.at(x - fp.x0, y - fp.y0);
-            slab.tau[size_t(i)] += tau;
-            slab.emission[size_t(i)] += tau * p.color;
-        }
+    // The filter was set up at projection (PointSetup): only this tile's pixels are evaluated.
+    PointRaster r;
+    r.cx = p.centre.x, r.cy = p.centre.y;
+    r.invVariance = p.shape.x, r.total = p.shape.y, r.norm = p.shape.z, r.radius2 = p.scale;
+    r.color = p.color;
+    r.x0 = std::max(p.range.x0, px.x0), r.x1 = std::min(p.range.x1, px.x1);
+    r.y0 = std::max(p.range.y0, px.y0), r.y1 = std::min(p.range.y1, px.y1);
+    r.epsilon = kTransmittanceEpsilon;
+    r.table = &standardPointFilterTable();
+    const SlabTile tile{slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.T.data(), px.x0, px.y0};
+    exact_.vector ? drawPointVector(r, tile) : drawPointScalar(r, tile);
     slab.dirty = true;
 }
 

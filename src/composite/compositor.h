@@ -78,8 +78,8 @@ private:
     /// The rare kinds that need more (SplatExact, NearEye) read the window's Primitive.
     struct TileRecord {
         glm::vec2 centre;      // point position / ellipse centre (pixels)
-        glm::vec3 shape;       // splat: conic (Qxx, Qxy, Qyy); point: (variance, total, 0)
-        float scale;           // splat: σ·h·amplitude
+        glm::vec3 shape;       // splat: conic (Qxx, Qxy, Qyy); point: (1/V, total, norm) (PointSetup)
+        float scale;           // splat: σ·h·amplitude; point: r_s²
         float sin2Alpha;       // splat: the polynomial's (or the reindex table's) row
         glm::vec3 color;
         PixelRange range;
@@ -101,7 +101,6 @@ private:
     int width_, height_, tilesX_, tilesY_;
     const Tables& tables_;
     ExactContext exact_;
-    PointFilterTable pointFilter_;
     template <class T>
     using Buffer = std::vector<T, HugePageAllocator<T>>;  // large: in huge pages (util/huge_pages.h)
     Buffer<glm::vec3> color_;             // premultiplied radiance

@@ -41,6 +41,9 @@ struct Primitive {
     // Point
     float variance = 0.f;       ///< V_point, px²
     float total = 0.f;          ///< Σ_pixels τ (DESIGN §4 energy rule)
+    /// The filter set up once from centre and variance (pointfilter/point_filter.h, PointSetup);
+    /// `range` is then its footprint clamped to the image (empty: nothing on screen).
+    float pointInvVariance = 0.f, pointRadius2 = 0.f, pointNorm = 0.f;
     // Splat (table path)
     glm::vec3 conic{0.f};       ///< Q as (Qxx, Qxy, Qyy): i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²
     float scale = 0.f;          ///< σ_k·h·amplitude (SplatShader::scale)

@@ -47,6 +47,20 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float sp
     return p;
 }
 
+/// The point's filter, once (PointSetup): the compositor then evaluates only the pixels of
+/// each tile it touches, and bins it by its footprint instead of the ±kPointMaxRadiusPx box.
+void setUpPointFilter(Primitive& p, int width, int height) {
+    const PointSetup s = setupPoint(standardPointFilterTable(), PixelCoord(p.centre), double(p.variance));
+    p.pointInvVariance = s.invVariance, p.pointRadius2 = s.radius2, p.pointNorm = s.norm;
+    if (s.empty()) {
+        p.range = {};
+        return;
+    }
+    // The footprint lies inside the ±kPointMaxRadiusPx box it replaces (r_s ≤ kPointMaxRadiusPx).
+    p.range.x0 = std::max(s.x0, 0), p.range.y0 = std::max(s.y0, 0);
+    p.range.x1 = std::min(s.x0 + s.nx - 1, width - 1), p.range.y1 = std::min(s.y0 + s.ny - 1, height - 1);
+}
+
 Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, const ProjectionContext& ctx) {
     Primitive p;
     const double h = ctx.voxelSize;
@@ -140,6 +154,7 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
                               : makeSplat(c, sigma, spacingPx, ctx);
     if (point && ctx.mode == RenderMode::None && p.kind == PrimitiveKind::Point)
         snapToNearestPixel(p, ctx.camera.width(), ctx.camera.height());
+    if (p.kind == PrimitiveKind::Point) setUpPointFilter(p, ctx.camera.width(), ctx.camera.height());
     p.color = (!point && ctx.showPrimitives) ? splatTint(color) : color;
     return p;
 }

@@ -1,0 +1,104 @@
+// composite/point_raster.cpp — a point's filter over one tile with Google Highway (see
+// point_raster.h). Compiled once per SIMD target (foreach_target.h); HWY_DYNAMIC_DISPATCH picks
+// the best the CPU supports at run time. Built with -ffp-contract=off (CMakeLists.txt): a fused
+// multiply-add would round differently from the scalar oracle.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "composite/point_raster.cpp"
+#include <hwy/foreach_target.h>  // must come before highway.h
+#include <hwy/highway.h>
+
+#include <algorithm>
+
+#include "composite/point_raster.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace vdbsplat {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+constexpr int kStride = 16;  // tile row stride (kTileSize)
+
+template <class D>
+void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
+    using V = hn::Vec<D>;
+    constexpr int N = int(hn::MaxLanes(D()));
+    const hn::RebindToSigned<D> di;
+    const PointFilterTable& table = *p.table;
+    // The tile's columns in vectors of N: the first and last that hold footprint pixels.
+    const int c0 = (p.x0 - tile.x0) / N * N, c1 = (p.x1 - tile.x0) / N * N;
+    // Per column of the footprint (once per point and tile; scalar: ≤ 7 table lookups, where a
+    // vector gather of a whole row costs more): dx² and the column's weight. The other columns
+    // of the vectors are masked off below.
+    alignas(64) float dx2s[kStride] = {}, gxs[kStride] = {};
+    for (int x = p.x0; x <= p.x1; ++x) {
+        const float dx = (float(x) + 0.5f) - p.cx;
+        dx2s[x - tile.x0] = dx * dx;
+        gxs[x - tile.x0] = table.weight(dx * dx * p.invVariance);
+    }
+    const V eps = hn::Set(d, p.epsilon), rs2 = hn::Set(d, p.radius2), total = hn::Set(d, p.total),
+            norm = hn::Set(d, p.norm);
+    const V cr = hn::Set(d, p.color.x), cg = hn::Set(d, p.color.y), cb = hn::Set(d, p.color.z);
+    const auto before = hn::Set(di, p.x0 - tile.x0 - 1), after = hn::Set(di, p.x1 - tile.x0 + 1);
+    for (int y = p.y0; y <= p.y1; ++y) {
+        const float dy = (float(y) + 0.5f) - p.cy, dy2 = dy * dy;
+        const V gy = hn::Set(d, table.weight(dy2 * p.invVariance)), vdy2 = hn::Set(d, dy2);
+        const int row = (y - tile.y0) * kStride;
+        for (int c = c0; c <= c1; c += N) {
+            const auto col = hn::Iota(di, c);
+            const auto inRange = hn::RebindMask(d, hn::And(hn::Gt(col, before), hn::Lt(col, after)));
+            const V dx2 = hn::Load(d, dx2s + c);
+            const auto mask = hn::And(hn::And(inRange, hn::Ge(hn::Load(d, tile.T + row + c), eps)),
+                                      hn::Lt(hn::Add(dx2, vdy2), rs2));
+            if (hn::AllFalse(d, mask)) continue;
+            const V tau = hn::Mul(total, hn::Mul(hn::Mul(hn::Load(d, gxs + c), gy), norm));
+            float* const pt = tile.tau + row + c;
+            float* const pr = tile.er + row + c;
+            float* const pg = tile.eg + row + c;
+            float* const pb = tile.eb + row + c;
+            const V t0 = hn::Load(d, pt), r0 = hn::Load(d, pr), g0 = hn::Load(d, pg), b0 = hn::Load(d, pb);
+            hn::Store(hn::IfThenElse(mask, hn::Add(t0, tau), t0), d, pt);
+            hn::Store(hn::IfThenElse(mask, hn::Add(r0, hn::Mul(tau, cr)), r0), d, pr);
+            hn::Store(hn::IfThenElse(mask, hn::Add(g0, hn::Mul(tau, cg)), g0), d, pg);
+            hn::Store(hn::IfThenElse(mask, hn::Add(b0, hn::Mul(tau, cb)), b0), d, pb);
+        }
+    }
+}
+
+void DrawPoint(const PointRaster& p, const SlabTile& tile) {
+    if (p.x0 > p.x1 || p.y0 > p.y1) return;
+    DrawPointFor(hn::CappedTag<float, kStride>(), p, tile);
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace vdbsplat
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace vdbsplat {
+
+HWY_EXPORT(DrawPoint);
+
+void drawPointVector(const PointRaster& p, const SlabTile& tile) { HWY_DYNAMIC_DISPATCH(DrawPoint)(p, tile); }
+
+void drawPointScalar(const PointRaster& p, const SlabTile& tile) {
+    constexpr int kStride = 16;
+    const PointFilterTable& table = *p.table;
+    for (int y = p.y0; y <= p.y1; ++y) {
+        const float dy = PointSetup::offset(y, p.cy), dy2 = dy * dy;
+        const float gy = table.weight(dy2 * p.invVariance);
+        for (int x = p.x0; x <= p.x1; ++x) {
+            const int i = (y - tile.y0) * kStride + (x - tile.x0);
+            if (!(tile.T[i] >= p.epsilon)) continue;
+            const float dx = PointSetup::offset(x, p.cx), dx2 = dx * dx;
+            const float w = dx2 + dy2 < p.radius2 ? table.weight(dx2 * p.invVariance) * gy : 0.0f;
+            const float tau = p.total * (w * p.norm);
+            tile.tau[i] += tau;
+            tile.er[i] += tau * p.color.x;
+            tile.eg[i] += tau * p.color.y;
+            tile.eb[i] += tau * p.color.z;
+        }
+    }
+}
+
+}  // namespace vdbsplat
+#endif  // HWY_ONCE
