@@ -3,6 +3,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <cmath>
 
@@ -159,20 +160,28 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
     return p;
 }
 
-std::span<const Primitive> projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx,
-                                        PrimitiveBuffer& prims) {
-    growDiscarding(prims, batch.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-            Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
-            p.members = batch.members[i];
-            p.depth = batch.distance[i];
-            p.slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
-                                         batch.slabEnd - 1);
-            prims[i] = p;
-        }
-    });
-    return {prims.data(), batch.size()};
+ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window) {
+    window.slabBase = batch.slabBegin;
+    window.resize(batch.size());
+    return tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, batch.size(), 1024), ProjectionCounts{},
+        [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
+                p.members = batch.members[i];
+                p.depth = batch.distance[i];
+                p.slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
+                                             batch.slabEnd - 1);
+                window.set(i, p);
+                if (p.kind == PrimitiveKind::Culled) continue;
+                ++(p.kind == PrimitiveKind::Point ? c.points : c.splats);
+                if (p.kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
+                c.drawnVoxels += p.members;
+                if (p.members > 1) ++c.lodAggregates, c.lodVoxels += p.members;
+            }
+            return c;
+        },
+        [](ProjectionCounts a, const ProjectionCounts& b) { return a += b; });
 }
 
 }  // namespace vdbsplat

@@ -42,11 +42,22 @@ struct ProjectionContext {
     const VoxelShape* shape = nullptr;
 };
 
-/// @brief Projects every voxel of @p batch into the first batch.size() elements of @p prims
-/// (grown when needed, with headroom, never shrunk: the buffer is reused window after window).
-/// @return the primitives of this batch, prims[0 … batch.size()).
-std::span<const Primitive> projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx,
-                                        PrimitiveBuffer& prims);
+/// What one window's primitives draw, before the compositor's occlusion culling (integer sums:
+/// the same for any split of the work).
+struct ProjectionCounts {
+    uint64_t points = 0, splats = 0, exactIndexSplats = 0, lodAggregates = 0, lodVoxels = 0, drawnVoxels = 0;
+    ProjectionCounts& operator+=(const ProjectionCounts& o) {
+        points += o.points, splats += o.splats, exactIndexSplats += o.exactIndexSplats;
+        lodAggregates += o.lodAggregates, lodVoxels += o.lodVoxels, drawnVoxels += o.drawnVoxels;
+        return *this;
+    }
+};
+
+/// @brief Projects every voxel of @p batch into @p window (grown when needed, never shrunk: it
+/// is reused window after window): primitive i from voxel i (projectVoxel), with the voxel's
+/// depth, its slab clamped to the batch's, and its member count; window.slabBase is the
+/// batch's first slab. @return what the primitives draw, by kind.
+ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window);
 
 /// @brief Projects one voxel (view-space centre @p c, extinction per voxel length @p sigma).
 /// @param spreadPx2 a level-of-detail aggregate's projected second moment (px², added to
