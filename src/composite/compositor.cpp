@@ -146,7 +146,7 @@ SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, doubl
 /// One global sort by (key, index), then a gather: every tile's list comes out in order
 /// without a per-tile sort, and the tiles read their primitives sequentially (indexing the
 /// window in key order was a cache miss per primitive at far views). The key passes and the
-/// gather are parallel over fixed chunks of the window; the sort is a serial radix sort of
+/// gather (binToTiles) are parallel over fixed chunks of the window; the sort is a parallel radix sort of
 /// the packed keys (KeyLayout: typically 20–30 bits, 3–4 passes, several times faster than a
 /// comparison sort of the 16-byte entries). Nothing depends on the thread count; what is
 /// gathered is the 64-byte TileRecord, not the Primitive.
@@ -195,18 +195,13 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
     });
     // order_ is in index order; the stable sort by key makes it the total (key, index) order.
     if (radixSort(order_.data(), sortScratch_.data(), total, layout.bits) != order_.data()) std::swap(order_, sortScratch_);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, total, 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t k = r.begin(); k < r.end(); ++k) {
-            const uint32_t i = order_[k].index;
-            const TileRecord& q = records_[k] = window.records[i];
-            if (q.hasExactMap) maps_[k] = window.extra[i].exactMap;
-        }
-    });
+    // The records are gathered in this order by binToTiles' first pass.
 }
 
-/// Bins records_ into per-tile lists (CSR: binStart_, binEntries_), each list ascending in
-/// sorted position, skipping tiles that are already opaque. Parallel over fixed chunks of
-/// records_: count per (chunk, tile), prefix sums, fill; the lists do not depend on the chunking.
+/// Gathers the window's records into records_ in sorted order and bins them into per-tile lists
+/// (CSR: binStart_, binEntries_), each list ascending in sorted position, skipping tiles that are
+/// already opaque. Parallel over fixed chunks of records_: gather and count per (chunk, tile),
+/// prefix sums, fill; the lists do not depend on the chunking.
 SkippedPrimitives TileCompositor::binToTiles() {
     const size_t tiles = size_t(tilesX_) * tilesY_, n = orderCount_;
     const size_t chunks = std::clamp<size_t>(n / 16384, 1, 16), per = (n + chunks - 1) / chunks;
@@ -221,11 +216,17 @@ SkippedPrimitives TileCompositor::binToTiles() {
                 if (liveCount_[tile] > 0) fn(tile);
             }
     };
+    // Gather the records in sorted order (and the exact-index maps), counting each one's tiles.
+    const ProjectedWindow& window = *window_;
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         uint32_t* count = counts.data() + c * tiles;
         SkippedPrimitives& skipped = skippedIn[c];
-        for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k) {
-            const TileRecord& p = records_[k];
+        const size_t end = std::min(n, (c + 1) * per);
+        for (size_t k = c * per; k < end; ++k) {
+            if (k + 8 < end) __builtin_prefetch(&window.records[order_[k + 8].index]);  // a random line each
+            const uint32_t i = order_[k].index;
+            const TileRecord& p = records_[k] = window.records[i];
+            if (p.hasExactMap) maps_[k] = window.extra[i].exactMap;
             bool any = false;
             forTiles(p.range, [&](size_t tile) { ++count[tile], any = true; });
             if (!any) {

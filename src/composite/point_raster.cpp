@@ -18,6 +18,36 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 constexpr int kStride = 16;  // tile row stride (kTileSize)
 
+/// PointFilterTable::weight on every lane: 0 where !(x < maxX); else the linear lookup, with
+/// weight()'s float operations (two gathers: cheaper here than a scalar lookup per pixel row
+/// and column).
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V Weight(D d, const PointFilterTable& table, V x) {
+    const hn::RebindToSigned<D> di;
+    const auto valid = hn::Lt(x, hn::Set(d, PointFilterTable::maxX()));  // false for NaN
+    const V t = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, table.indexScale()));
+    const auto k = hn::Min(hn::ConvertTo(di, t), hn::Set(di, PointFilterTable::kIntervals - 1));
+    const V w = hn::Sub(t, hn::ConvertTo(d, k));
+    const V v0 = hn::GatherIndex(d, table.values(), k), v1 = hn::GatherIndex(d, table.values() + 1, k);
+    return hn::IfThenElseZero(valid, hn::Add(v0, hn::Mul(w, hn::Sub(v1, v0))));
+}
+
+/// The squared offsets (x + ½ − c)² of the tile's 16 columns (or rows) from @p c, and their
+/// weights, into @p sq and @p g (for the vectors from @p first to @p last).
+template <class D>
+HWY_INLINE void AxisWeights(D d, const PointFilterTable& table, int origin, float c, float invV, int first, int last,
+                            float* sq, float* g) {
+    constexpr int N = int(hn::MaxLanes(D()));
+    const hn::RebindToSigned<D> di;
+    for (int k = first; k <= last; k += N) {
+        const auto x = hn::ConvertTo(d, hn::Iota(di, origin + k));
+        const auto dx = hn::Sub(hn::Add(x, hn::Set(d, 0.5f)), hn::Set(d, c));
+        const auto dx2 = hn::Mul(dx, dx);
+        hn::Store(dx2, d, sq + k);
+        hn::Store(Weight(d, table, hn::Mul(dx2, hn::Set(d, invV))), d, g + k);
+    }
+}
+
 template <class D>
 void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
     using V = hn::Vec<D>;
@@ -26,23 +56,18 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
     const PointFilterTable& table = *p.table;
     // The tile's columns in vectors of N: the first and last that hold footprint pixels.
     const int c0 = (p.x0 - tile.x0) / N * N, c1 = (p.x1 - tile.x0) / N * N;
-    // Per column of the footprint (once per point and tile; scalar: ≤ 7 table lookups, where a
-    // vector gather of a whole row costs more): dx² and the column's weight. The other columns
-    // of the vectors are masked off below.
-    alignas(64) float dx2s[kStride] = {}, gxs[kStride] = {};
-    for (int x = p.x0; x <= p.x1; ++x) {
-        const float dx = (float(x) + 0.5f) - p.cx;
-        dx2s[x - tile.x0] = dx * dx;
-        gxs[x - tile.x0] = table.weight(dx * dx * p.invVariance);
-    }
+    const int r0 = (p.y0 - tile.y0) / N * N, r1 = (p.y1 - tile.y0) / N * N;
+    // Per column and per row of the tile (once per point and tile): the squared offset and its weight.
+    alignas(64) float dx2s[kStride], gxs[kStride], dy2s[kStride], gys[kStride];
+    AxisWeights(d, table, tile.x0, p.cx, p.invVariance, c0, c1, dx2s, gxs);
+    AxisWeights(d, table, tile.y0, p.cy, p.invVariance, r0, r1, dy2s, gys);
     const V eps = hn::Set(d, p.epsilon), rs2 = hn::Set(d, p.radius2), total = hn::Set(d, p.total),
             norm = hn::Set(d, p.norm);
     const V cr = hn::Set(d, p.color.x), cg = hn::Set(d, p.color.y), cb = hn::Set(d, p.color.z);
     const auto before = hn::Set(di, p.x0 - tile.x0 - 1), after = hn::Set(di, p.x1 - tile.x0 + 1);
     for (int y = p.y0; y <= p.y1; ++y) {
-        const float dy = (float(y) + 0.5f) - p.cy, dy2 = dy * dy;
-        const V gy = hn::Set(d, table.weight(dy2 * p.invVariance)), vdy2 = hn::Set(d, dy2);
-        const int row = (y - tile.y0) * kStride;
+        const int ly = y - tile.y0, row = ly * kStride;
+        const V gy = hn::Set(d, gys[ly]), vdy2 = hn::Set(d, dy2s[ly]);
         for (int c = c0; c <= c1; c += N) {
             const auto col = hn::Iota(di, c);
             const auto inRange = hn::RebindMask(d, hn::And(hn::Gt(col, before), hn::Lt(col, after)));
@@ -55,9 +80,9 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
             float* const pr = tile.er + row + c;
             float* const pg = tile.eg + row + c;
             float* const pb = tile.eb + row + c;
-            const V t0 = hn::Load(d, pt), r0 = hn::Load(d, pr), g0 = hn::Load(d, pg), b0 = hn::Load(d, pb);
+            const V t0 = hn::Load(d, pt), r0v = hn::Load(d, pr), g0 = hn::Load(d, pg), b0 = hn::Load(d, pb);
             hn::Store(hn::IfThenElse(mask, hn::Add(t0, tau), t0), d, pt);
-            hn::Store(hn::IfThenElse(mask, hn::Add(r0, hn::Mul(tau, cr)), r0), d, pr);
+            hn::Store(hn::IfThenElse(mask, hn::Add(r0v, hn::Mul(tau, cr)), r0v), d, pr);
             hn::Store(hn::IfThenElse(mask, hn::Add(g0, hn::Mul(tau, cg)), g0), d, pg);
             hn::Store(hn::IfThenElse(mask, hn::Add(b0, hn::Mul(tau, cb)), b0), d, pb);
         }

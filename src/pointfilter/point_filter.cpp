@@ -116,8 +116,10 @@ PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double
     for (int iy = 0; iy < s.ny; ++iy) {
         const float dy = static_cast<float>(s.y0 + iy + 0.5 - x.y), dy2 = dy * dy;
         const float gy = table.weight(dy2 * invV);
-        for (int ix = 0; ix < s.nx; ++ix)
-            if (dx2[size_t(ix)] + dy2 < rs2) sum += gx[size_t(ix)] * gy;
+        for (int ix = 0; ix < s.nx; ++ix) {  // branch-free: which pixels the circle keeps varies point by point
+            const float w = gx[size_t(ix)] * gy;
+            sum += dx2[size_t(ix)] + dy2 < rs2 ? w : 0.0f;
+        }
     }
     if (sum > 0.0f) {
         s.invVariance = invV, s.radius2 = rs2, s.norm = 1.0f / sum;
