@@ -100,13 +100,6 @@ TileCompositor::TileCompositor(int width, int height, const Tables& tables, cons
                                                     (std::min(height_, (ty + 1) * kTileSize) - ty * kTileSize);
 }
 
-bool TileCompositor::hidden(int x0, int y0, int x1, int y1) const {
-    for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)
-        for (int tx = x0 / kTileSize; tx <= x1 / kTileSize; ++tx)
-            if (liveCount_[size_t(ty) * tilesX_ + tx] > 0) return false;
-    return true;
-}
-
 Image TileCompositor::image() const {
     Image image(width_, height_);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, image.pixels.size(), 16384), [&](const tbb::blocked_range<size_t>& r) {

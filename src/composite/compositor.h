@@ -64,7 +64,12 @@ public:
     SkippedPrimitives composite(std::span<const Primitive> prims, double& binSeconds, double& compositeSeconds);
 
     /// @brief True if every pixel of the inclusive rectangle is already opaque (T < ε).
-    bool hidden(int x0, int y0, int x1, int y1) const;
+    bool hidden(int x0, int y0, int x1, int y1) const {
+        for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)
+            for (int tx = x0 / kTileSize; tx <= x1 / kTileSize; ++tx)
+                if (liveCount_[size_t(ty) * tilesX_ + tx] > 0) return false;
+        return true;
+    }
 
     /// @brief The image so far: premultiplied colour, alpha = 1 − T.
     Image image() const;

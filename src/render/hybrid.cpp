@@ -50,6 +50,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
                           settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
                           pass.prefilterVariance};
     ctx.shape = &shape;
+    ctx.occlusion = &compositor;
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
     ProjectedWindow window;
@@ -67,7 +68,9 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
         stats.lodAggregates += counts.lodAggregates, stats.lodVoxels += counts.lodVoxels;
         drawnVoxels += counts.drawnVoxels;
         stats.projectSeconds += since(t);
-        const SkippedPrimitives hiddenPrims = compositor.composite(window, stats.rasterizeSeconds, stats.compositeSeconds);
+        SkippedPrimitives hiddenPrims = compositor.composite(window, stats.rasterizeSeconds, stats.compositeSeconds);
+        hiddenPrims.points += counts.hidden.points, hiddenPrims.splats += counts.hidden.splats;
+        hiddenPrims.exactIndexSplats += counts.hidden.exactIndexSplats, hiddenPrims.voxels += counts.hidden.voxels;
         stats.points -= hiddenPrims.points;
         stats.splats -= hiddenPrims.splats;
         stats.exactIndexSplats -= hiddenPrims.exactIndexSplats;

@@ -178,6 +178,13 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                 if (p.kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
                 c.drawnVoxels += p.members;
                 if (p.members > 1) ++c.lodAggregates, c.lodVoxels += p.members;
+                if (ctx.occlusion && !p.range.empty() &&
+                    ctx.occlusion->hidden(p.range.x0, p.range.y0, p.range.x1, p.range.y1)) {
+                    window.order[i] = ProjectedWindow::kNotDrawn;
+                    ++(p.kind == PrimitiveKind::Point ? c.hidden.points : c.hidden.splats);
+                    if (p.kind == PrimitiveKind::SplatExactIndex) ++c.hidden.exactIndexSplats;
+                    c.hidden.voxels += p.members;
+                }
             }
             return c;
         },
