@@ -95,17 +95,34 @@ int ceilSmall(double v) {
 }
 }  // namespace
 
-PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double variance) {
-    PointSetup s;
-    // rasterizePoint's footprint and its sum, in its order (row by row; a term outside the
-    // circle is +0 there and changes no sum), without storing the weights.
+bool pointSetupBox(const PixelCoord& x, double variance, PointSetup& s, float& invV, float& rs2) {
+    s = PointSetup{};
     if (!std::isfinite(x.x) || !std::isfinite(x.y) || !(variance > 0.0) || x.x < -1e9 || x.x > 1e9 ||
         x.y < -1e9 || x.y > 1e9)
-        return s;
+        return false;
     const double rs = std::min(kPointSupportSigmas * std::sqrt(variance), kPointMaxRadiusPx);
     s.x0 = floorSmall(x.x - 0.5 - rs) + 1, s.nx = std::clamp(ceilSmall(x.x - 0.5 + rs) - 1 - s.x0 + 1, 0, kPointMaxSide);
     s.y0 = floorSmall(x.y - 0.5 - rs) + 1, s.ny = std::clamp(ceilSmall(x.y - 0.5 + rs) - 1 - s.y0 + 1, 0, kPointMaxSide);
-    const float invV = static_cast<float>(1.0 / variance), rs2 = static_cast<float>(rs * rs);
+    invV = static_cast<float>(1.0 / variance), rs2 = static_cast<float>(rs * rs);
+    return true;
+}
+
+void finishPointSetup(PointSetup& s, const PixelCoord& x, float sum, float invV, float rs2) {
+    if (sum > 0.0f) {
+        s.invVariance = invV, s.radius2 = rs2, s.norm = 1.0f / sum;
+    } else {  // rasterizePoint's fallback: one pixel of weight weight(0)·weight(0)·1 = 1
+        s.x0 = floorSmall(x.x), s.y0 = floorSmall(x.y);
+        s.nx = s.ny = 1;
+        s.invVariance = 0.0f, s.radius2 = INFINITY, s.norm = 1.0f;
+    }
+}
+
+PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double variance) {
+    // rasterizePoint's footprint and its sum, in its order (row by row; a term outside the
+    // circle is +0 there and changes no sum), without storing the weights.
+    PointSetup s;
+    float invV = 0.0f, rs2 = 0.0f;
+    if (!pointSetupBox(x, variance, s, invV, rs2)) return s;
     std::array<float, kPointMaxSide> dx2{}, gx{};
     for (int ix = 0; ix < s.nx; ++ix) {
         const float dx = static_cast<float>(s.x0 + ix + 0.5 - x.x);
@@ -121,13 +138,7 @@ PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double
             sum += dx2[size_t(ix)] + dy2 < rs2 ? w : 0.0f;
         }
     }
-    if (sum > 0.0f) {
-        s.invVariance = invV, s.radius2 = rs2, s.norm = 1.0f / sum;
-    } else {  // rasterizePoint's fallback: one pixel of weight weight(0)·weight(0)·1 = 1
-        s.x0 = floorSmall(x.x), s.y0 = floorSmall(x.y);
-        s.nx = s.ny = 1;
-        s.invVariance = 0.0f, s.radius2 = INFINITY, s.norm = 1.0f;
-    }
+    finishPointSetup(s, x, sum, invV, rs2);
     return s;
 }
 

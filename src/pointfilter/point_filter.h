@@ -116,6 +116,17 @@ struct PointSetup {
 /// filter variance @p variance (the float it stores): rasterizePoint's footprint and sum.
 PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double variance);
 
+/// @brief setupPoint's sum with Google Highway (pointfilter/point_setup.cpp, runtime dispatch):
+/// the weights of both axes in one vector (two gathers), the products and the circle row by row
+/// in vectors, then the sum in setupPoint's order. For a float centre (what the renderer stores)
+/// the same PointSetup bit for bit (PointFilter.VectorSetupEqualsTheScalarSetup).
+PointSetup setupPointVector(const PointFilterTable& table, const PixelCoord& x, double variance);
+
+/// setupPoint's parts before and after the sum (shared by the scalar and the vector setup):
+/// the footprint's box, 1/V and r_s² (false: nothing to draw); then norm, or the one-pixel fallback.
+bool pointSetupBox(const PixelCoord& x, double variance, PointSetup& s, float& invV, float& rs2);
+void finishPointSetup(PointSetup& s, const PixelCoord& x, float sum, float invV, float rs2);
+
 /// @brief One weight of @p s at pixel (@p x, @p y) of its box, for a point centred at
 /// (@p cx, @p cy): the scalar form of what the compositor evaluates per tile.
 inline float pointWeight(const PointFilterTable& table, const PointSetup& s, float cx, float cy, int x, int y) {

@@ -51,6 +51,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
                           pass.prefilterVariance};
     ctx.shape = &shape;
     ctx.occlusion = &compositor;
+    ctx.vector = settings.simd;
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
     ProjectedWindow window;

@@ -50,8 +50,10 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float sp
 
 /// The point's filter, once (PointSetup): the compositor then evaluates only the pixels of
 /// each tile it touches, and bins it by its footprint instead of the ±kPointMaxRadiusPx box.
-void setUpPointFilter(Primitive& p, int width, int height) {
-    const PointSetup s = setupPoint(standardPointFilterTable(), PixelCoord(p.centre), double(p.variance));
+void setUpPointFilter(Primitive& p, int width, int height, bool vector) {
+    const PixelCoord centre(p.centre);
+    const PointSetup s = vector ? setupPointVector(standardPointFilterTable(), centre, double(p.variance))
+                                : setupPoint(standardPointFilterTable(), centre, double(p.variance));
     p.pointInvVariance = s.invVariance, p.pointRadius2 = s.radius2, p.pointNorm = s.norm;
     if (s.empty()) {
         p.range = {};
@@ -155,7 +157,7 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
                               : makeSplat(c, sigma, spacingPx, ctx);
     if (point && ctx.mode == RenderMode::None && p.kind == PrimitiveKind::Point)
         snapToNearestPixel(p, ctx.camera.width(), ctx.camera.height());
-    if (p.kind == PrimitiveKind::Point) setUpPointFilter(p, ctx.camera.width(), ctx.camera.height());
+    if (p.kind == PrimitiveKind::Point) setUpPointFilter(p, ctx.camera.width(), ctx.camera.height(), ctx.vector);
     p.color = (!point && ctx.showPrimitives) ? splatTint(color) : color;
     return p;
 }

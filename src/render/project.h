@@ -45,6 +45,9 @@ struct ProjectionContext {
     /// all lie in opaque tiles is counted as hidden and not passed on (ProjectionCounts), as the
     /// compositor's binning would skip it, so it is neither sorted nor gathered.
     const TileCompositor* occlusion = nullptr;
+    /// Points' filter set up through the vector sum (setupPointVector); false: setupPoint, the
+    /// scalar oracle (--simd off). The same values either way.
+    bool vector = true;
 };
 
 /// What one window's primitives draw, before the compositor's occlusion culling (integer sums:

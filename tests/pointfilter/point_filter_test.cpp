@@ -195,5 +195,35 @@ TEST(PointFilter, SetupMatchesTheFootprint) {
     EXPECT_TRUE(setupPoint(t, {1.0, 1.0}, 0.0).empty());
 }
 
+// The vector setup (setupPointVector: both axes' weights in one vector, the terms row by row in
+// vectors, the sum in the scalar order) is the scalar setup bit for bit, for float centres (what
+// the renderer stores), including centres at and near 0, past the image's edges, and the fallback.
+TEST(PointFilter, VectorSetupEqualsTheScalarSetup) {
+    const PointFilterTable& t = standardPointFilterTable();
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    int fallbacks = 0;
+    for (int trial = 0; trial < 50000; ++trial) {
+        const int kind = trial % 10;
+        float cx = float(-30 + int(2000 * u(rng))) + u(rng), cy = float(-30 + int(1200 * u(rng))) + u(rng);
+        if (kind == 0) cx = 1e-6f * u(rng), cy = -1e-7f * u(rng);  // at and near the origin
+        if (kind == 1) cx = std::floor(cx) + 0.5f;                  // on a pixel centre
+        const float v = kind == 2 ? float(1e-4 + 1e-3 * u(rng))
+                        : kind == 3 ? float(kNearestPixelVariance)
+                                    : float(pointFilterVariance(4.0 * u(rng), trial % 2 ? 0.1 : 1.0));
+        const PointSetup a = setupPoint(t, PixelCoord(cx, cy), v), b = setupPointVector(t, PixelCoord(cx, cy), v);
+        ASSERT_EQ(a.x0, b.x0) << trial;
+        ASSERT_EQ(a.y0, b.y0) << trial;
+        ASSERT_EQ(a.nx, b.nx) << trial;
+        ASSERT_EQ(a.ny, b.ny) << trial;
+        ASSERT_EQ(a.invVariance, b.invVariance) << trial;
+        ASSERT_EQ(a.radius2, b.radius2) << trial;
+        ASSERT_EQ(a.norm, b.norm) << "trial " << trial << " centre " << cx << ", " << cy << " V " << v;
+        fallbacks += a.invVariance == 0.0f && !a.empty();
+    }
+    EXPECT_GT(fallbacks, 100);
+    EXPECT_TRUE(setupPointVector(t, {std::nan(""), 1.0}, 1.5).empty());
+}
+
 }  // namespace
 }  // namespace vdbsplat
