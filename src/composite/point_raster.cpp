@@ -32,22 +32,6 @@ HWY_INLINE V Weight(D d, const PointFilterTable& table, V x) {
     return hn::IfThenElseZero(valid, hn::Add(v0, hn::Mul(w, hn::Sub(v1, v0))));
 }
 
-/// The squared offsets (x + ½ − c)² of the tile's 16 columns (or rows) from @p c, and their
-/// weights, into @p sq and @p g (for the vectors from @p first to @p last).
-template <class D>
-HWY_INLINE void AxisWeights(D d, const PointFilterTable& table, int origin, float c, float invV, int first, int last,
-                            float* sq, float* g) {
-    constexpr int N = int(hn::MaxLanes(D()));
-    const hn::RebindToSigned<D> di;
-    for (int k = first; k <= last; k += N) {
-        const auto x = hn::ConvertTo(d, hn::Iota(di, origin + k));
-        const auto dx = hn::Sub(hn::Add(x, hn::Set(d, 0.5f)), hn::Set(d, c));
-        const auto dx2 = hn::Mul(dx, dx);
-        hn::Store(dx2, d, sq + k);
-        hn::Store(Weight(d, table, hn::Mul(dx2, hn::Set(d, invV))), d, g + k);
-    }
-}
-
 template <class D>
 void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
     using V = hn::Vec<D>;
@@ -56,18 +40,37 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
     const PointFilterTable& table = *p.table;
     // The tile's columns in vectors of N: the first and last that hold footprint pixels.
     const int c0 = (p.x0 - tile.x0) / N * N, c1 = (p.x1 - tile.x0) / N * N;
-    const int r0 = (p.y0 - tile.y0) / N * N, r1 = (p.y1 - tile.y0) / N * N;
-    // Per column and per row of the tile (once per point and tile): the squared offset and its weight.
-    alignas(64) float dx2s[kStride], gxs[kStride], dy2s[kStride], gys[kStride];
-    AxisWeights(d, table, tile.x0, p.cx, p.invVariance, c0, c1, dx2s, gxs);
-    AxisWeights(d, table, tile.y0, p.cy, p.invVariance, r0, r1, dy2s, gys);
+    // Per column and per row of the footprint's part in the tile (once per point and tile): the
+    // squared offset and its weight, both axes in one vector of 16 (lanes 0–7 the columns from
+    // p.x0, 8–15 the rows from p.y0: one pair of gathers), then put on the tile's lanes.
+    alignas(64) float sq[16], g[16];
+    {
+        const hn::CappedTag<float, 16> d16;
+        const hn::RebindToSigned<decltype(d16)> di16;
+        constexpr int N16 = int(hn::MaxLanes(d16));
+        for (int k = 0; k < 16; k += N16) {
+            const auto lane = hn::Iota(di16, k);
+            const auto isX = hn::Lt(lane, hn::Set(di16, 8));
+            const auto pixel = hn::IfThenElse(isX, hn::Add(lane, hn::Set(di16, p.x0)), hn::Add(lane, hn::Set(di16, p.y0 - 8)));
+            const auto centre = hn::IfThenElse(hn::RebindMask(d16, isX), hn::Set(d16, p.cx), hn::Set(d16, p.cy));
+            const auto off = hn::Sub(hn::Add(hn::ConvertTo(d16, pixel), hn::Set(d16, 0.5f)), centre);
+            const auto off2 = hn::Mul(off, off);
+            hn::Store(off2, d16, sq + k);
+            hn::Store(Weight(d16, table, hn::Mul(off2, hn::Set(d16, p.invVariance))), d16, g + k);
+        }
+    }
+    // The columns on the tile's lanes: lanes past the footprint's part hold other columns' values
+    // (or zeros), masked off below.
+    alignas(64) float dx2s[kStride + 8] = {}, gxs[kStride + 8] = {};
+    const int at = p.x0 - tile.x0;
+    std::copy_n(sq, 8, dx2s + at), std::copy_n(g, 8, gxs + at);
     const V eps = hn::Set(d, p.epsilon), rs2 = hn::Set(d, p.radius2), total = hn::Set(d, p.total),
             norm = hn::Set(d, p.norm);
     const V cr = hn::Set(d, p.color.x), cg = hn::Set(d, p.color.y), cb = hn::Set(d, p.color.z);
     const auto before = hn::Set(di, p.x0 - tile.x0 - 1), after = hn::Set(di, p.x1 - tile.x0 + 1);
     for (int y = p.y0; y <= p.y1; ++y) {
-        const int ly = y - tile.y0, row = ly * kStride;
-        const V gy = hn::Set(d, gys[ly]), vdy2 = hn::Set(d, dy2s[ly]);
+        const int ly = y - p.y0, row = (y - tile.y0) * kStride;
+        const V gy = hn::Set(d, g[8 + ly]), vdy2 = hn::Set(d, sq[8 + ly]);
         for (int c = c0; c <= c1; c += N) {
             const auto col = hn::Iota(di, c);
             const auto inRange = hn::RebindMask(d, hn::And(hn::Gt(col, before), hn::Lt(col, after)));
