@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "composite/opacity.h"
+#include "composite/point_raster.h"
 #include "composite/splat_raster.h"
 #include "footprint/kernel.h"
 
@@ -27,25 +28,21 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 ///     key = ((slab − slabBase) · 2 + kind) · 2^depthBits + (depth bits − depthBase)
 /// with the depth's float bits (monotone for floats ≥ 0), so the radix sort makes few passes.
 struct KeyLayout {
-    int64_t slabBase = 0;
+    uint32_t orderBase = 0;  ///< the smallest ProjectedWindow::order (relative slab·2 + kind)
     uint32_t depthBase = 0;
     int depthBits = 0;
     int bits = 0;  ///< the key's width
 
-    static uint32_t depthOf(const Primitive& p) { return std::bit_cast<uint32_t>(std::max(p.depth, 0.f)); }
-    static uint64_t slabOf(const Primitive& p, int64_t base) {
-        return uint64_t(std::clamp<int64_t>(p.slab - base, 0, (int64_t(1) << 27) - 1));
-    }
-    uint64_t key(const Primitive& p) const {
-        const uint64_t kind = p.kind == PrimitiveKind::Point ? 0 : 1;
-        return ((slabOf(p, slabBase) << 1 | kind) << depthBits) | (depthOf(p) - depthBase);
+    static uint32_t depthOf(float depth) { return std::bit_cast<uint32_t>(std::max(depth, 0.f)); }
+    uint64_t key(uint32_t order, float depth) const {
+        return (uint64_t(order - orderBase) << depthBits) | (depthOf(depth) - depthBase);
     }
 };
 
 /// Per chunk of a window: drawable primitives and the range of their slabs and depth bits.
 struct ChunkRange {
     size_t count = 0;
-    int64_t slabLo = std::numeric_limits<int64_t>::max(), slabHi = std::numeric_limits<int64_t>::min();
+    uint32_t orderLo = std::numeric_limits<uint32_t>::max(), orderHi = 0;
     uint32_t depthLo = std::numeric_limits<uint32_t>::max(), depthHi = 0;
 };
 
@@ -78,10 +75,13 @@ Entry* radixSort(Entry* a, Entry* scratch, size_t n, int bits) {
 }
 }  // namespace
 
-/// Optical depth and σ-weighted colour of the points of the current slab, per tile pixel.
+/// Optical depth and σ-weighted colour of the points of the current slab, per tile pixel
+/// (structure of arrays, 64-byte aligned: the point loop loads whole rows; point_raster.h).
 struct TileCompositor::SlabBuffer {
-    std::array<float, kTileSize * kTileSize> tau{};
-    std::array<glm::vec3, kTileSize * kTileSize> emission{};
+    alignas(64) std::array<float, kTileSize * kTileSize> tau{};
+    alignas(64) std::array<float, kTileSize * kTileSize> er{};
+    alignas(64) std::array<float, kTileSize * kTileSize> eg{};
+    alignas(64) std::array<float, kTileSize * kTileSize> eb{};
     bool dirty = false;
 };
 
@@ -100,13 +100,6 @@ TileCompositor::TileCompositor(int width, int height, const Tables& tables, cons
                                                     (std::min(height_, (ty + 1) * kTileSize) - ty * kTileSize);
 }
 
-bool TileCompositor::hidden(int x0, int y0, int x1, int y1) const {
-    for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)
-        for (int tx = x0 / kTileSize; tx <= x1 / kTileSize; ++tx)
-            if (liveCount_[size_t(ty) * tilesX_ + tx] > 0) return false;
-    return true;
-}
-
 Image TileCompositor::image() const {
     Image image(width_, height_);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, image.pixels.size(), 16384), [&](const tbb::blocked_range<size_t>& r) {
@@ -116,9 +109,18 @@ Image TileCompositor::image() const {
 }
 
 SkippedPrimitives TileCompositor::composite(std::span<const Primitive> prims, double& binSeconds, double& compositeSeconds) {
+    int64_t base = std::numeric_limits<int64_t>::max();
+    for (const Primitive& p : prims) base = std::min(base, p.slab);
+    packed_.slabBase = prims.empty() ? 0 : base;
+    packed_.resize(prims.size());
+    for (size_t i = 0; i < prims.size(); ++i) packed_.set(i, prims[i]);
+    return composite(packed_, binSeconds, compositeSeconds);
+}
+
+SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, double& binSeconds, double& compositeSeconds) {
     const auto t0 = Clock::now();
-    window_ = prims;
-    sortWindow(prims);
+    window_ = &window;
+    sortWindow(window);
     const SkippedPrimitives skipped = binToTiles();
     binSeconds += since(t0);
     const auto t1 = Clock::now();
@@ -130,31 +132,33 @@ SkippedPrimitives TileCompositor::composite(std::span<const Primitive> prims, do
         }
     });
     compositeSeconds += since(t1);
-    window_ = {};
+    window_ = nullptr;
     return skipped;
 }
 
 /// One global sort by (key, index), then a gather: every tile's list comes out in order
 /// without a per-tile sort, and the tiles read their primitives sequentially (indexing the
 /// window in key order was a cache miss per primitive at far views). The key passes and the
-/// gather are parallel over fixed chunks of the window; the sort is a serial radix sort of
+/// gather (binToTiles) are parallel over fixed chunks of the window; the sort is a parallel radix sort of
 /// the packed keys (KeyLayout: typically 20–30 bits, 3–4 passes, several times faster than a
 /// comparison sort of the 16-byte entries). Nothing depends on the thread count; what is
 /// gathered is the 64-byte TileRecord, not the Primitive.
-void TileCompositor::sortWindow(std::span<const Primitive> prims) {
-    const size_t n = prims.size();
+void TileCompositor::sortWindow(const ProjectedWindow& window) {
+    const size_t n = window.size;
     const size_t chunks = std::clamp<size_t>(n / 16384, 1, 64), per = (n + chunks - 1) / chunks;
-    const auto drawable = [](const Primitive& p) { return p.kind != PrimitiveKind::Culled && !p.range.empty(); };
-    // Per chunk: drawable primitives and the range of their keys.
+    const uint32_t* orderOf = window.order.data();
+    const float* depthOf = window.depth.data();
+    // Per chunk: drawable primitives and the range of their keys (8 bytes read per primitive).
     std::vector<ChunkRange> range(chunks);
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         ChunkRange& r = range[c];
         for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) {
-            const Primitive& p = prims[i];
-            if (!drawable(p)) continue;
+            const uint32_t o = orderOf[i];
+            if (o == ProjectedWindow::kNotDrawn) continue;
             ++r.count;
-            r.slabLo = std::min(r.slabLo, p.slab), r.slabHi = std::max(r.slabHi, p.slab);
-            r.depthLo = std::min(r.depthLo, KeyLayout::depthOf(p)), r.depthHi = std::max(r.depthHi, KeyLayout::depthOf(p));
+            const uint32_t d = KeyLayout::depthOf(depthOf[i]);
+            r.orderLo = std::min(r.orderLo, o), r.orderHi = std::max(r.orderHi, o);
+            r.depthLo = std::min(r.depthLo, d), r.depthHi = std::max(r.depthHi, d);
         }
     });
     ChunkRange all;
@@ -162,16 +166,16 @@ void TileCompositor::sortWindow(std::span<const Primitive> prims) {
     cursor.assign(chunks, 0);
     for (size_t c = 0; c < chunks; ++c) {
         cursor[c] = all.count, all.count += range[c].count;
-        all.slabLo = std::min(all.slabLo, range[c].slabLo), all.slabHi = std::max(all.slabHi, range[c].slabHi);
+        all.orderLo = std::min(all.orderLo, range[c].orderLo), all.orderHi = std::max(all.orderHi, range[c].orderHi);
         all.depthLo = std::min(all.depthLo, range[c].depthLo), all.depthHi = std::max(all.depthHi, range[c].depthHi);
     }
     const size_t total = all.count;
     KeyLayout layout;
     if (total > 0) {
-        layout.slabBase = all.slabLo, layout.depthBase = all.depthLo;
+        // order = relative slab·2 + kind: the slab's bits and the kind's one.
+        layout.orderBase = all.orderLo & ~1u, layout.depthBase = all.depthLo;
         layout.depthBits = int(std::bit_width(all.depthHi - all.depthLo));
-        const uint64_t slabSpan = uint64_t(std::min<int64_t>(all.slabHi - all.slabLo, (int64_t(1) << 27) - 1));
-        layout.bits = int(std::bit_width(slabSpan)) + 1 + layout.depthBits;
+        layout.bits = int(std::bit_width(all.orderHi - layout.orderBase)) + layout.depthBits;
     }
     // Buffers grow only (default-initialised: nothing is written until the parallel passes).
     growDiscarding(order_, total), growDiscarding(sortScratch_, total);
@@ -180,30 +184,17 @@ void TileCompositor::sortWindow(std::span<const Primitive> prims) {
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         size_t k = cursor[c];
         for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i)
-            if (drawable(prims[i])) order_[k++] = {layout.key(prims[i]), uint32_t(i)};
+            if (orderOf[i] != ProjectedWindow::kNotDrawn) order_[k++] = {layout.key(orderOf[i], depthOf[i]), uint32_t(i)};
     });
     // order_ is in index order; the stable sort by key makes it the total (key, index) order.
     if (radixSort(order_.data(), sortScratch_.data(), total, layout.bits) != order_.data()) std::swap(order_, sortScratch_);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, total, 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t k = r.begin(); k < r.end(); ++k) {
-            const Primitive& p = prims[order_[k].index];
-            TileRecord& q = records_[k];
-            q.centre = p.centre;
-            q.shape = p.kind == PrimitiveKind::Point ? glm::vec3(p.variance, p.total, 0.f) : p.conic;
-            q.scale = p.scale, q.sin2Alpha = p.sin2Alpha;
-            q.color = p.color;
-            q.range = p.range;
-            q.slab = uint32_t(std::clamp<int64_t>(p.slab - layout.slabBase, 0, std::numeric_limits<uint32_t>::max()));
-            q.kind = p.kind;
-            q.hasExactMap = p.hasExactMap;
-            if (p.hasExactMap) maps_[k] = p.exactMap;
-        }
-    });
+    // The records are gathered in this order by binToTiles' first pass.
 }
 
-/// Bins records_ into per-tile lists (CSR: binStart_, binEntries_), each list ascending in
-/// sorted position, skipping tiles that are already opaque. Parallel over fixed chunks of
-/// records_: count per (chunk, tile), prefix sums, fill; the lists do not depend on the chunking.
+/// Gathers the window's records into records_ in sorted order and bins them into per-tile lists
+/// (CSR: binStart_, binEntries_), each list ascending in sorted position, skipping tiles that are
+/// already opaque. Parallel over fixed chunks of records_: gather and count per (chunk, tile),
+/// prefix sums, fill; the lists do not depend on the chunking.
 SkippedPrimitives TileCompositor::binToTiles() {
     const size_t tiles = size_t(tilesX_) * tilesY_, n = orderCount_;
     const size_t chunks = std::clamp<size_t>(n / 16384, 1, 16), per = (n + chunks - 1) / chunks;
@@ -218,17 +209,23 @@ SkippedPrimitives TileCompositor::binToTiles() {
                 if (liveCount_[tile] > 0) fn(tile);
             }
     };
+    // Gather the records in sorted order (and the exact-index maps), counting each one's tiles.
+    const ProjectedWindow& window = *window_;
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         uint32_t* count = counts.data() + c * tiles;
         SkippedPrimitives& skipped = skippedIn[c];
-        for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k) {
-            const TileRecord& p = records_[k];
+        const size_t end = std::min(n, (c + 1) * per);
+        for (size_t k = c * per; k < end; ++k) {
+            if (k + 8 < end) __builtin_prefetch(&window.records[order_[k + 8].index]);  // a random line each
+            const uint32_t i = order_[k].index;
+            const TileRecord& p = records_[k] = window.records[i];
+            if (p.hasExactMap) maps_[k] = window.extra[i].exactMap;
             bool any = false;
             forTiles(p.range, [&](size_t tile) { ++count[tile], any = true; });
             if (!any) {
                 ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
                 if (p.kind == PrimitiveKind::SplatExactIndex) ++skipped.exactIndexSplats;
-                skipped.voxels += window_[order_[k].index].members;
+                skipped.voxels += window_->members[order_[k].index];
             }
         }
     });
@@ -309,10 +306,10 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
         for (int y = px.y0; y <= px.y1; ++y)
             for (int x = px.x0; x <= px.x1; ++x) {
                 const int i = px.local(x, y);
-                const float tau = slab.tau[size_t(i)];
-                if (tau > 0.f) px.over(i, tau, slab.emission[size_t(i)] / tau);
-                slab.tau[size_t(i)] = 0.f;
-                slab.emission[size_t(i)] = glm::vec3(0.f);
+                const size_t j = size_t(i);
+                const float tau = slab.tau[j];
+                if (tau > 0.f) px.over(i, tau, glm::vec3(slab.er[j], slab.eg[j], slab.eb[j]) / tau);
+                slab.tau[j] = 0.f, slab.er[j] = 0.f, slab.eg[j] = 0.f, slab.eb[j] = 0.f;
             }
         slab.dirty = false;
     };
@@ -338,10 +335,10 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
             case PrimitiveKind::Point: drawPoint(p, px, slab); break;
             case PrimitiveKind::Splat: drawSplat(p, maps_[k], px); break;
             case PrimitiveKind::SplatExactIndex:  // without its map: the half-ray fallback
-                p.hasExactMap ? drawSplat(p, maps_[k], px) : drawExact(window_[order_[k].index], px);
+                p.hasExactMap ? drawSplat(p, maps_[k], px) : drawExact(p, window_->extra[order_[k].index], px);
                 break;
             case PrimitiveKind::SplatExact:
-            case PrimitiveKind::NearEye: drawExact(window_[order_[k].index], px); break;
+            case PrimitiveKind::NearEye: drawExact(p, window_->extra[order_[k].index], px); break;
             case PrimitiveKind::Culled: break;
         }
     }
@@ -356,18 +353,17 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
 }
 
 void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBuffer& slab) const {
-    const float variance = p.shape.x, total = p.shape.y;
-    const PointFootprint fp = rasterizePoint(pointFilter_, PixelCoord(p.centre), variance);
-    const int x0 = std::max(fp.x0, px.x0), x1 = std::min(fp.x0 + fp.nx - 1, px.x1);
-    const int y0 = std::max(fp.y0, px.y0), y1 = std::min(fp.y0 + fp.ny - 1, px.y1);
-    for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) {
-            const int i = px.local(x, y);
-            if (!px.live(i)) continue;
-            const float tau = total * fp.at(x - fp.x0, y - fp.y0);
-            slab.tau[size_t(i)] += tau;
-            slab.emission[size_t(i)] += tau * p.color;
-        }
+    // The filter was set up at projection (PointSetup): only this tile's pixels are evaluated.
+    PointRaster r;
+    r.cx = p.centre.x, r.cy = p.centre.y;
+    r.invVariance = p.shape.x, r.total = p.shape.y, r.norm = p.shape.z, r.radius2 = p.scale;
+    r.color = p.color;
+    r.x0 = std::max(p.range.x0, px.x0), r.x1 = std::min(p.range.x1, px.x1);
+    r.y0 = std::max(p.range.y0, px.y0), r.y1 = std::min(p.range.y1, px.y1);
+    r.epsilon = kTransmittanceEpsilon;
+    r.table = &standardPointFilterTable();
+    const SlabTile tile{slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.T.data(), px.x0, px.y0};
+    exact_.vector ? drawPointVector(r, tile) : drawPointScalar(r, tile);
     slab.dirty = true;
 }
 
@@ -424,24 +420,24 @@ void TileCompositor::drawSplatTables(const TileRecord& p, const ExactIndexMap& m
     }
 }
 
-void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
+void TileCompositor::drawExact(const TileRecord& p, const PrimitiveExtra& extra, TilePixels& px) const {
     const Camera& camera = *exact_.camera;
     if (exact_.shape && !exact_.shape->sphere) {  // an ellipsoid at the eye: the exact half-ray integral
         const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
         const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
-        const glm::dvec3 c(p.viewPos);
+        const glm::dvec3 c(extra.viewPos);
         for (int y = y0; y <= y1; ++y)
             for (int x = x0; x <= x1; ++x) {
                 const int i = px.local(x, y);
                 if (!px.live(i)) continue;
-                const double tau = p.sigma * ellipsoidHalfRayDeposit(*exact_.shape, c, camera.viewRay(PixelCoord(x + 0.5, y + 0.5)));
+                const double tau = extra.sigma * ellipsoidHalfRayDeposit(*exact_.shape, c, camera.viewRay(PixelCoord(x + 0.5, y + 0.5)));
                 if (tau > 0.0) px.over(i, float(tau), p.color);
             }
         return;
     }
     const double h = exact_.voxelSize;
     const KernelShape& shape = *tables_.kernel;
-    const SphereProjection sphere = projectSphere(camera, ViewPoint(p.viewPos), shape.radius() * h);
+    const SphereProjection sphere = projectSphere(camera, ViewPoint(extra.viewPos), shape.radius() * h);
     // Recomputed from the float view position: a borderline sphere may no longer be an
     // Ellipse, and then takes the half-ray fallback like a NearEye kernel.
     const bool widened = p.kind != PrimitiveKind::NearEye && sphere.isEllipse();
@@ -449,14 +445,14 @@ void TileCompositor::drawExact(const Primitive& p, TilePixels& px) const {
     if (widened) kernel = makeScreenKernel(sphere, exact_.prefilterVariance, shape);
     const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
     const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
-    const double sigmaWorld = p.sigma / h;
+    const double sigmaWorld = extra.sigma / h;
     for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
             const int i = px.local(x, y);
             if (!px.live(i)) continue;
             const PixelCoord q(x + 0.5, y + 0.5);
             const double tau =
-                widened ? splatDepositExact(kernel, sphere, sigmaWorld, h, q, shape) : p.sigma * halfRayFootprint(sphere, q, shape);
+                widened ? splatDepositExact(kernel, sphere, sigmaWorld, h, q, shape) : extra.sigma * halfRayFootprint(sphere, q, shape);
             if (tau > 0.0) px.over(i, float(tau), p.color);
         }
 }

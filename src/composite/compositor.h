@@ -57,12 +57,19 @@ class TileCompositor {
 public:
     TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact);
 
-    /// @brief Composites @p prims (one depth window, any order) behind everything before.
+    /// @brief Composites @p window (one depth window, any order) behind everything before.
     /// @return the primitives skipped because every tile they touch is opaque.
+    SkippedPrimitives composite(const ProjectedWindow& window, double& binSeconds, double& compositeSeconds);
+    /// @brief The same for primitives one by one (tests): packed into a ProjectedWindow first.
     SkippedPrimitives composite(std::span<const Primitive> prims, double& binSeconds, double& compositeSeconds);
 
     /// @brief True if every pixel of the inclusive rectangle is already opaque (T < ε).
-    bool hidden(int x0, int y0, int x1, int y1) const;
+    bool hidden(int x0, int y0, int x1, int y1) const {
+        for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)
+            for (int tx = x0 / kTileSize; tx <= x1 / kTileSize; ++tx)
+                if (liveCount_[size_t(ty) * tilesX_ + tx] > 0) return false;
+        return true;
+    }
 
     /// @brief The image so far: premultiplied colour, alpha = 1 − T.
     Image image() const;
@@ -73,41 +80,29 @@ private:
         uint32_t index;  // primitive index: the tie-break
         bool operator<(const Entry& o) const { return key != o.key ? key < o.key : index < o.index; }
     };
-    /// What the tile loop reads of one primitive, gathered in sort order: one 64-byte line
-    /// instead of the projection's ~200-byte Primitive (gsplat: sort keys, not records).
-    /// The rare kinds that need more (SplatExact, NearEye) read the window's Primitive.
-    struct TileRecord {
-        glm::vec2 centre;      // point position / ellipse centre (pixels)
-        glm::vec3 shape;       // splat: conic (Qxx, Qxy, Qyy); point: (variance, total, 0)
-        float scale;           // splat: σ·h·amplitude
-        float sin2Alpha;       // splat: the polynomial's (or the reindex table's) row
-        glm::vec3 color;
-        PixelRange range;
-        uint32_t slab;         // relative to the window's first slab
-        PrimitiveKind kind;
-        bool hasExactMap;      // SplatExactIndex: maps_ holds its ExactIndexMap
-    };
-    static_assert(sizeof(TileRecord) == 64, "one cache line per primitive");
+    /// What the tile loop reads of one primitive (PrimitiveRecord, one 64-byte line), gathered
+    /// in sort order. The rare kinds that need more (SplatExact, NearEye) read the window's extra.
+    using TileRecord = PrimitiveRecord;
     struct SlabBuffer;
     struct TilePixels;  // one tile's transmittance and colour, copied in and out (thread-local)
-    void sortWindow(std::span<const Primitive> prims);
+    void sortWindow(const ProjectedWindow& window);
     SkippedPrimitives binToTiles();
     void compositeTile(int tile, std::span<const uint32_t> entries);
     void drawPoint(const TileRecord& p, const TilePixels& tile, SlabBuffer& slab) const;
     void drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile) const;
     void drawSplatTables(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile) const;
-    void drawExact(const Primitive& p, TilePixels& tile) const;
+    void drawExact(const TileRecord& p, const PrimitiveExtra& extra, TilePixels& tile) const;
 
     int width_, height_, tilesX_, tilesY_;
     const Tables& tables_;
     ExactContext exact_;
-    PointFilterTable pointFilter_;
     template <class T>
     using Buffer = std::vector<T, HugePageAllocator<T>>;  // large: in huge pages (util/huge_pages.h)
     Buffer<glm::vec3> color_;             // premultiplied radiance
     Buffer<float> transmittance_;
     std::vector<int> liveCount_;          // per tile: pixels with T ≥ ε
-    std::span<const Primitive> window_;   // the window being composited (composite()'s argument)
+    const ProjectedWindow* window_ = nullptr;  // the window being composited (composite()'s argument)
+    ProjectedWindow packed_;              // composite(span<const Primitive>)'s window
     size_t orderCount_ = 0;               // the window's drawable primitives (the buffers grow only)
     Buffer<Entry> order_;                 // the window's drawable primitives in (key, index) order
     Buffer<Entry> sortScratch_;           // the radix sort's second buffer

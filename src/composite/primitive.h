@@ -1,9 +1,12 @@
 // composite/primitive.h — the projected primitives the compositor consumes.
-// Owns: Primitive, the one record per voxel that leaves the projection stage
-// (render/project.h) and enters the tile compositor (composite/compositor.h):
+// Owns: Primitive, everything projection knows of one voxel (render/project.h, projectVoxel):
 // a filtered point (DESIGN §4, circular pixel filter w), an EWA splat (exact
 // ellipse widened by the low-pass, (i, α) reindex + footprint table), or a
-// near-eye kernel drawn with the exact half-ray integral (ellipse.h fallback).
+// near-eye kernel drawn with the exact half-ray integral (ellipse.h fallback);
+// and ProjectedWindow, a window of them as the renderer passes it on: structure of arrays
+// (a 64-byte PrimitiveRecord the tiles draw, the order key's parts, the voxel count, and the
+// rare kinds' extra data), so that each pass reads only what it needs (~80 B per primitive
+// written by projection instead of the ~200-byte Primitive).
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -41,6 +44,9 @@ struct Primitive {
     // Point
     float variance = 0.f;       ///< V_point, px²
     float total = 0.f;          ///< Σ_pixels τ (DESIGN §4 energy rule)
+    /// The filter set up once from centre and variance (pointfilter/point_filter.h, PointSetup);
+    /// `range` is then its footprint clamped to the image (empty: nothing on screen).
+    float pointInvVariance = 0.f, pointRadius2 = 0.f, pointNorm = 0.f;
     // Splat (table path)
     glm::vec3 conic{0.f};       ///< Q as (Qxx, Qxy, Qyy): i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²
     float scale = 0.f;          ///< σ_k·h·amplitude (SplatShader::scale)
@@ -55,6 +61,77 @@ struct Primitive {
 
 /// The projected window: reused window after window, in huge pages (util/huge_pages.h).
 using PrimitiveBuffer = std::vector<Primitive, HugePageAllocator<Primitive>>;
+
+/// What the tile loop reads of one primitive, in one 64-byte line (gsplat: sort keys, not
+/// records). The rare kinds that need more read the window's PrimitiveExtra.
+struct PrimitiveRecord {
+    glm::vec2 centre;      ///< point position / ellipse centre (pixels)
+    glm::vec3 shape;       ///< splat: conic (Qxx, Qxy, Qyy); point: (1/V, total, norm) (PointSetup)
+    float scale;           ///< splat: σ·h·amplitude; point: r_s²
+    float sin2Alpha;       ///< splat: the polynomial's (or the reindex table's) row
+    glm::vec3 color;
+    PixelRange range;
+    uint32_t slab;         ///< relative to the window's first slab (ProjectedWindow::slabBase)
+    PrimitiveKind kind;
+    bool hasExactMap;      ///< SplatExactIndex: its PrimitiveExtra holds its ExactIndexMap
+};
+static_assert(sizeof(PrimitiveRecord) == 64, "one cache line per primitive");
+
+/// What only SplatExactIndex (the map), SplatExact and NearEye (recomputed per tile) read.
+struct PrimitiveExtra {
+    ExactIndexMap exactMap;
+    glm::vec3 viewPos{0.f};
+    float sigma = 0.f;
+};
+inline bool needsExtra(PrimitiveKind kind) {
+    return kind == PrimitiveKind::SplatExactIndex || kind == PrimitiveKind::SplatExact || kind == PrimitiveKind::NearEye;
+}
+
+/// A window of primitives, structure of arrays, element i from voxel i of the batch. Reused
+/// window after window (the buffers grow only), in huge pages.
+struct ProjectedWindow {
+    template <class T>
+    using Buffer = std::vector<T, HugePageAllocator<T>>;
+    /// `order` of a primitive that draws nothing (culled, or no pixel on screen).
+    static constexpr uint32_t kNotDrawn = UINT32_MAX;
+    /// Slabs are kept relative to slabBase below this (2^27, as the compositor's sort key).
+    static constexpr int64_t kMaxRelativeSlab = (int64_t(1) << 27) - 1;
+
+    size_t size = 0;
+    int64_t slabBase = 0;              ///< the first slab: records' and order's slabs are relative to it
+    Buffer<PrimitiveRecord> records;
+    Buffer<uint32_t> order;            ///< the sort key's high part: relative slab·2 + (not a point), or kNotDrawn
+    Buffer<float> depth;               ///< radial distance of the voxel centre (world units): the order in a slab
+    Buffer<uint32_t> members;          ///< active voxels each stands for
+    Buffer<PrimitiveExtra> extra;      ///< written only where needsExtra(kind)
+
+    /// Grows the buffers to @p n primitives (contents undefined until set()).
+    void resize(size_t n) {
+        growDiscarding(records, n), growDiscarding(order, n), growDiscarding(depth, n);
+        growDiscarding(members, n), growDiscarding(extra, n);
+        size = n;
+    }
+    /// Stores @p p as primitive @p i (its slab relative to slabBase, clamped to [0, kMaxRelativeSlab]).
+    void set(size_t i, const Primitive& p) {
+        PrimitiveRecord& q = records[i];
+        const bool point = p.kind == PrimitiveKind::Point;
+        const uint32_t slab = uint32_t(std::clamp<int64_t>(p.slab - slabBase, 0, kMaxRelativeSlab));
+        q.centre = p.centre;
+        q.shape = point ? glm::vec3(p.pointInvVariance, p.total, p.pointNorm) : p.conic;
+        q.scale = point ? p.pointRadius2 : p.scale;
+        q.sin2Alpha = p.sin2Alpha;
+        q.color = p.color;
+        q.range = p.range;
+        q.slab = slab;
+        q.kind = p.kind;
+        q.hasExactMap = p.hasExactMap;
+        const bool drawn = p.kind != PrimitiveKind::Culled && !p.range.empty();
+        order[i] = drawn ? slab << 1 | (point ? 0u : 1u) : kNotDrawn;
+        depth[i] = p.depth;
+        members[i] = p.members;
+        if (needsExtra(p.kind)) extra[i] = PrimitiveExtra{p.exactMap, p.viewPos, p.sigma};
+    }
+};
 
 /// @brief The half cone angle α = asin(sin α) of a splat from its stored sin²α (DESIGN §2):
 /// the table path's reindex row; the projection itself needs no trigonometry.

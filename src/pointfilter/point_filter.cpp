@@ -82,4 +82,69 @@ PointFootprint rasterizePoint(const PointFilterTable& table, const PixelCoord& x
     return out;
 }
 
+namespace {
+/// floor and ceil of a finite |v| < 2³¹ by an integer cast and a compare (std::floor and
+/// std::ceil are libm calls on the x86-64 baseline); exact, so the same integers.
+int floorSmall(double v) {
+    const int i = static_cast<int>(v);
+    return i - (static_cast<double>(i) > v ? 1 : 0);
+}
+int ceilSmall(double v) {
+    const int i = static_cast<int>(v);
+    return i + (static_cast<double>(i) < v ? 1 : 0);
+}
+}  // namespace
+
+bool pointSetupBox(const PixelCoord& x, double variance, PointSetup& s, float& invV, float& rs2) {
+    s = PointSetup{};
+    if (!std::isfinite(x.x) || !std::isfinite(x.y) || !(variance > 0.0) || x.x < -1e9 || x.x > 1e9 ||
+        x.y < -1e9 || x.y > 1e9)
+        return false;
+    const double rs = std::min(kPointSupportSigmas * std::sqrt(variance), kPointMaxRadiusPx);
+    s.x0 = floorSmall(x.x - 0.5 - rs) + 1, s.nx = std::clamp(ceilSmall(x.x - 0.5 + rs) - 1 - s.x0 + 1, 0, kPointMaxSide);
+    s.y0 = floorSmall(x.y - 0.5 - rs) + 1, s.ny = std::clamp(ceilSmall(x.y - 0.5 + rs) - 1 - s.y0 + 1, 0, kPointMaxSide);
+    invV = static_cast<float>(1.0 / variance), rs2 = static_cast<float>(rs * rs);
+    return true;
+}
+
+void finishPointSetup(PointSetup& s, const PixelCoord& x, float sum, float invV, float rs2) {
+    if (sum > 0.0f) {
+        s.invVariance = invV, s.radius2 = rs2, s.norm = 1.0f / sum;
+    } else {  // rasterizePoint's fallback: one pixel of weight weight(0)·weight(0)·1 = 1
+        s.x0 = floorSmall(x.x), s.y0 = floorSmall(x.y);
+        s.nx = s.ny = 1;
+        s.invVariance = 0.0f, s.radius2 = INFINITY, s.norm = 1.0f;
+    }
+}
+
+PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double variance) {
+    // rasterizePoint's footprint and its sum, in its order (row by row; a term outside the
+    // circle is +0 there and changes no sum), without storing the weights.
+    PointSetup s;
+    float invV = 0.0f, rs2 = 0.0f;
+    if (!pointSetupBox(x, variance, s, invV, rs2)) return s;
+    std::array<float, kPointMaxSide> dx2{}, gx{};
+    for (int ix = 0; ix < s.nx; ++ix) {
+        const float dx = static_cast<float>(s.x0 + ix + 0.5 - x.x);
+        dx2[size_t(ix)] = dx * dx;
+        gx[size_t(ix)] = table.weight(dx * dx * invV);
+    }
+    float sum = 0.0f;
+    for (int iy = 0; iy < s.ny; ++iy) {
+        const float dy = static_cast<float>(s.y0 + iy + 0.5 - x.y), dy2 = dy * dy;
+        const float gy = table.weight(dy2 * invV);
+        for (int ix = 0; ix < s.nx; ++ix) {  // branch-free: which pixels the circle keeps varies point by point
+            const float w = gx[size_t(ix)] * gy;
+            sum += dx2[size_t(ix)] + dy2 < rs2 ? w : 0.0f;
+        }
+    }
+    finishPointSetup(s, x, sum, invV, rs2);
+    return s;
+}
+
+const PointFilterTable& standardPointFilterTable() {
+    static const PointFilterTable table;
+    return table;
+}
+
 }  // namespace vdbsplat

@@ -65,6 +65,11 @@ public:
     }
     /// @brief Max |weight − exp(−x/2)| over 16 samples per interval.
     double maxAbsError() const;
+    /// The kIntervals + 1 samples and x's scale to an interval (for vector loops doing weight()'s
+    /// arithmetic; composite/point_raster.cpp).
+    const float* values() const { return v_.data(); }
+    float indexScale() const { return scale_; }
+    static constexpr float maxX() { return kMaxXf; }
 
 private:
     static constexpr float kMaxXf = static_cast<float>(kMaxX);
@@ -84,7 +89,54 @@ struct PointFootprint {
 /// @brief Rasterizes w for a point projected at pixel coordinate @p x with filter variance
 /// @p variance (px², from pointFilterVariance): the pixels whose centres lie strictly
 /// within r_s = min(3√V, 3.5) of @p x, weights exp(−r²/2V) from @p table, renormalised
-/// to sum to 1. A non-finite @p x gives nx = ny = 0.
+/// to sum to 1. A non-finite @p x gives nx = ny = 0. The oracle of PointSetup.
 PointFootprint rasterizePoint(const PointFilterTable& table, const PixelCoord& x, double variance);
+
+/// @brief A point's filter set up once, at projection, so that each screen tile it touches
+/// evaluates only its own pixels (the compositor; rasterizePoint per tile recomputed the
+/// whole footprint and its sum for every tile). At pixel (x, y) of `box`, with the float
+/// offsets dx = x + ½ − centre.x, dy = y + ½ − centre.y (PointSetup::offset):
+///     w = (dx² + dy² < radius2 ? weight(dx²·invVariance) · weight(dy²·invVariance) : 0) · norm
+/// — the same float operations as rasterizePoint, so the same weights bit for bit
+/// (PointFilter.SetupMatchesTheFootprint). The fallback footprint (a single pixel, weight 1)
+/// has invVariance 0, radius2 +∞ and norm 1.
+struct PointSetup {
+    int x0 = 0, y0 = 0, nx = 0, ny = 0;  ///< the footprint's pixels, as PointFootprint (not clamped)
+    float invVariance = 0.f;           ///< 1/V
+    float radius2 = 0.f;               ///< r_s²: pixel centres strictly within it
+    float norm = 0.f;                  ///< 1 / (the weights' sum over the footprint)
+    bool empty() const { return nx <= 0 || ny <= 0; }
+    /// The float offset of pixel index @p i's centre from the coordinate @p c (x or y):
+    /// (i + ½) − c rounded once, as rasterizePoint's double difference rounded to float is
+    /// (the difference of a pixel centre and a float is exact in double at image coordinates).
+    static float offset(int i, float c) { return (float(i) + 0.5f) - c; }
+};
+
+/// @brief The PointSetup of a point at @p x (the float centre the compositor uses) with
+/// filter variance @p variance (the float it stores): rasterizePoint's footprint and sum.
+PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double variance);
+
+/// @brief setupPoint's sum with Google Highway (pointfilter/point_setup.cpp, runtime dispatch):
+/// the weights of both axes in one vector (two gathers), the products and the circle row by row
+/// in vectors, then the sum in setupPoint's order. For a float centre (what the renderer stores)
+/// the same PointSetup bit for bit (PointFilter.VectorSetupEqualsTheScalarSetup).
+PointSetup setupPointVector(const PointFilterTable& table, const PixelCoord& x, double variance);
+
+/// setupPoint's parts before and after the sum (shared by the scalar and the vector setup):
+/// the footprint's box, 1/V and r_s² (false: nothing to draw); then norm, or the one-pixel fallback.
+bool pointSetupBox(const PixelCoord& x, double variance, PointSetup& s, float& invV, float& rs2);
+void finishPointSetup(PointSetup& s, const PixelCoord& x, float sum, float invV, float rs2);
+
+/// @brief One weight of @p s at pixel (@p x, @p y) of its box, for a point centred at
+/// (@p cx, @p cy): the scalar form of what the compositor evaluates per tile.
+inline float pointWeight(const PointFilterTable& table, const PointSetup& s, float cx, float cy, int x, int y) {
+    const float dx = PointSetup::offset(x, cx), dy = PointSetup::offset(y, cy);
+    const float dy2 = dy * dy;
+    const float w = dx * dx + dy2 < s.radius2 ? table.weight(dx * dx * s.invVariance) * table.weight(dy2 * s.invVariance) : 0.0f;
+    return w * s.norm;
+}
+
+/// @brief The one table every point shares (deterministic, built on first use).
+const PointFilterTable& standardPointFilterTable();
 
 }  // namespace vdbsplat

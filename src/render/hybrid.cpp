@@ -1,8 +1,6 @@
 // render/hybrid.cpp — window-by-window forward resampling (see hybrid.h).
 #include "render/hybrid.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <chrono>
@@ -29,34 +27,6 @@ struct ForwardPass {
     double prefilterVariance;  ///< V_h folded into each primitive (px²)
 };
 
-/// What one window's primitives draw, before the compositor's occlusion culling.
-struct WindowCounts {
-    uint64_t points = 0, splats = 0, exactIndexSplats = 0, lodAggregates = 0, lodVoxels = 0, drawnVoxels = 0;
-    WindowCounts& operator+=(const WindowCounts& o) {
-        points += o.points, splats += o.splats, exactIndexSplats += o.exactIndexSplats;
-        lodAggregates += o.lodAggregates, lodVoxels += o.lodVoxels, drawnVoxels += o.drawnVoxels;
-        return *this;
-    }
-};
-
-/// Counts @p window in parallel (integer sums: the result does not depend on the split).
-WindowCounts countWindow(std::span<const Primitive> window) {
-    return tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, window.size(), 16384), WindowCounts{},
-        [&](const tbb::blocked_range<size_t>& r, WindowCounts c) {
-            for (size_t i = r.begin(); i < r.end(); ++i) {
-                const Primitive& p = window[i];
-                if (p.kind == PrimitiveKind::Culled) continue;
-                ++(p.kind == PrimitiveKind::Point ? c.points : c.splats);
-                if (p.kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
-                c.drawnVoxels += p.members;
-                if (p.members > 1) ++c.lodAggregates, c.lodVoxels += p.members;
-            }
-            return c;
-        },
-        [](WindowCounts a, const WindowCounts& b) { return a += b; });
-}
-
 /// Streams, projects and composites @p volume onto @p camera's pixels.
 Image composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, const Tables& tables,
                 const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
@@ -80,9 +50,11 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
                           settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
                           pass.prefilterVariance};
     ctx.shape = &shape;
+    ctx.occlusion = &compositor;
+    ctx.vector = settings.simd;
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
-    PrimitiveBuffer prims;
+    ProjectedWindow window;
     uint64_t drawnVoxels = 0;
     while (true) {
         if (control.stop && control.stop()) throw RenderStopped("render stopped");
@@ -91,14 +63,15 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
         if (!stream.next(batch, hidden)) break;
         stats.streamSeconds += since(t);
         t = Clock::now();
-        const std::span<const Primitive> window = projectBatch(batch, ctx, prims);
-        const WindowCounts counts = countWindow(window);
+        const ProjectionCounts counts = projectBatch(batch, ctx, window);
         stats.points += counts.points, stats.splats += counts.splats;
         stats.exactIndexSplats += counts.exactIndexSplats;
         stats.lodAggregates += counts.lodAggregates, stats.lodVoxels += counts.lodVoxels;
         drawnVoxels += counts.drawnVoxels;
         stats.projectSeconds += since(t);
-        const SkippedPrimitives hiddenPrims = compositor.composite(window, stats.rasterizeSeconds, stats.compositeSeconds);
+        SkippedPrimitives hiddenPrims = compositor.composite(window, stats.rasterizeSeconds, stats.compositeSeconds);
+        hiddenPrims.points += counts.hidden.points, hiddenPrims.splats += counts.hidden.splats;
+        hiddenPrims.exactIndexSplats += counts.hidden.exactIndexSplats, hiddenPrims.voxels += counts.hidden.voxels;
         stats.points -= hiddenPrims.points;
         stats.splats -= hiddenPrims.splats;
         stats.exactIndexSplats -= hiddenPrims.exactIndexSplats;

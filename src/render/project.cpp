@@ -3,6 +3,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <cmath>
 
@@ -45,6 +46,22 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float sp
     p.range = pixelRange(box, ctx.camera.width(), ctx.camera.height());
     if (p.range.empty() || !(p.total > 0.f)) p.kind = PrimitiveKind::Culled;
     return p;
+}
+
+/// The point's filter, once (PointSetup): the compositor then evaluates only the pixels of
+/// each tile it touches, and bins it by its footprint instead of the ±kPointMaxRadiusPx box.
+void setUpPointFilter(Primitive& p, int width, int height, bool vector) {
+    const PixelCoord centre(p.centre);
+    const PointSetup s = vector ? setupPointVector(standardPointFilterTable(), centre, double(p.variance))
+                                : setupPoint(standardPointFilterTable(), centre, double(p.variance));
+    p.pointInvVariance = s.invVariance, p.pointRadius2 = s.radius2, p.pointNorm = s.norm;
+    if (s.empty()) {
+        p.range = {};
+        return;
+    }
+    // The footprint lies inside the ±kPointMaxRadiusPx box it replaces (r_s ≤ kPointMaxRadiusPx).
+    p.range.x0 = std::max(s.x0, 0), p.range.y0 = std::max(s.y0, 0);
+    p.range.x1 = std::min(s.x0 + s.nx - 1, width - 1), p.range.y1 = std::min(s.y0 + s.ny - 1, height - 1);
 }
 
 Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, const ProjectionContext& ctx) {
@@ -140,24 +157,40 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
                               : makeSplat(c, sigma, spacingPx, ctx);
     if (point && ctx.mode == RenderMode::None && p.kind == PrimitiveKind::Point)
         snapToNearestPixel(p, ctx.camera.width(), ctx.camera.height());
+    if (p.kind == PrimitiveKind::Point) setUpPointFilter(p, ctx.camera.width(), ctx.camera.height(), ctx.vector);
     p.color = (!point && ctx.showPrimitives) ? splatTint(color) : color;
     return p;
 }
 
-std::span<const Primitive> projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx,
-                                        PrimitiveBuffer& prims) {
-    growDiscarding(prims, batch.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-            Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
-            p.members = batch.members[i];
-            p.depth = batch.distance[i];
-            p.slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
-                                         batch.slabEnd - 1);
-            prims[i] = p;
-        }
-    });
-    return {prims.data(), batch.size()};
+ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window) {
+    window.slabBase = batch.slabBegin;
+    window.resize(batch.size());
+    return tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, batch.size(), 1024), ProjectionCounts{},
+        [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
+                p.members = batch.members[i];
+                p.depth = batch.distance[i];
+                p.slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
+                                             batch.slabEnd - 1);
+                window.set(i, p);
+                if (p.kind == PrimitiveKind::Culled) continue;
+                ++(p.kind == PrimitiveKind::Point ? c.points : c.splats);
+                if (p.kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
+                c.drawnVoxels += p.members;
+                if (p.members > 1) ++c.lodAggregates, c.lodVoxels += p.members;
+                if (ctx.occlusion && !p.range.empty() &&
+                    ctx.occlusion->hidden(p.range.x0, p.range.y0, p.range.x1, p.range.y1)) {
+                    window.order[i] = ProjectedWindow::kNotDrawn;
+                    ++(p.kind == PrimitiveKind::Point ? c.hidden.points : c.hidden.splats);
+                    if (p.kind == PrimitiveKind::SplatExactIndex) ++c.hidden.exactIndexSplats;
+                    c.hidden.voxels += p.members;
+                }
+            }
+            return c;
+        },
+        [](ProjectionCounts a, const ProjectionCounts& b) { return a += b; });
 }
 
 }  // namespace vdbsplat

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "camera/camera.h"
+#include "composite/compositor.h"
 #include "composite/primitive.h"
 #include "footprint/ellipsoid.h"
 #include "footprint/prefilter.h"
@@ -40,13 +41,34 @@ struct ProjectionContext {
     /// axis, filters points with its projected spacing, and is splatted through its exact
     /// silhouette and the exact index-space distance (SplatExactIndex; --footprint does not apply).
     const VoxelShape* shape = nullptr;
+    /// The compositor whose opaque tiles hide primitives (null: none): a primitive whose pixels
+    /// all lie in opaque tiles is counted as hidden and not passed on (ProjectionCounts), as the
+    /// compositor's binning would skip it, so it is neither sorted nor gathered.
+    const TileCompositor* occlusion = nullptr;
+    /// Points' filter set up through the vector sum (setupPointVector); false: setupPoint, the
+    /// scalar oracle (--simd off). The same values either way.
+    bool vector = true;
 };
 
-/// @brief Projects every voxel of @p batch into the first batch.size() elements of @p prims
-/// (grown when needed, with headroom, never shrunk: the buffer is reused window after window).
-/// @return the primitives of this batch, prims[0 … batch.size()).
-std::span<const Primitive> projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx,
-                                        PrimitiveBuffer& prims);
+/// What one window's primitives draw, before the compositor's occlusion culling (integer sums:
+/// the same for any split of the work).
+struct ProjectionCounts {
+    uint64_t points = 0, splats = 0, exactIndexSplats = 0, lodAggregates = 0, lodVoxels = 0, drawnVoxels = 0;
+    SkippedPrimitives hidden;  ///< of those, hidden behind opaque tiles (ProjectionContext::occlusion)
+    ProjectionCounts& operator+=(const ProjectionCounts& o) {
+        points += o.points, splats += o.splats, exactIndexSplats += o.exactIndexSplats;
+        lodAggregates += o.lodAggregates, lodVoxels += o.lodVoxels, drawnVoxels += o.drawnVoxels;
+        hidden.points += o.hidden.points, hidden.splats += o.hidden.splats;
+        hidden.exactIndexSplats += o.hidden.exactIndexSplats, hidden.voxels += o.hidden.voxels;
+        return *this;
+    }
+};
+
+/// @brief Projects every voxel of @p batch into @p window (grown when needed, never shrunk: it
+/// is reused window after window): primitive i from voxel i (projectVoxel), with the voxel's
+/// depth, its slab clamped to the batch's, and its member count; window.slabBase is the
+/// batch's first slab. @return what the primitives draw, by kind.
+ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window);
 
 /// @brief Projects one voxel (view-space centre @p c, extinction per voxel length @p sigma).
 /// @param spreadPx2 a level-of-detail aggregate's projected second moment (px², added to

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "camera/camera.h"
+#include "util/huge_pages.h"
 #include "volume/grid.h"
 #include "volume/leaf_moments.h"
 #include "volume/transfer_function.h"
@@ -34,16 +35,20 @@ namespace vdbsplat {
 class VoxelShader;     // shading/shading_field.h
 class EmissionSource;  // volume/emission.h
 
-/// @brief One depth window of voxels, structure of arrays, in a deterministic order.
+/// @brief One depth window of voxels, structure of arrays, in a deterministic order. The arrays
+/// do not zero what they grow by (HugePageAllocator: every element is written before it is read),
+/// so a window's resize costs no serial pass over its memory.
 struct VoxelBatch {
-    std::vector<glm::vec3> viewPos;  ///< voxel centre in view space (eye at origin, +z forward)
-    std::vector<float> distance;     ///< |viewPos|, world units
-    std::vector<float> sigma;        ///< extinction per voxel length (σ_k·h; × its weight when blended)
-    std::vector<glm::vec3> color;    ///< emitted colour c_k (σ-weighted mean for an aggregate)
-    std::vector<float> spread;       ///< aggregate: projected second moment about the centroid
-                                     ///< beyond a full cell's, isotropic (trace/2), px²; 0 for a voxel
-    std::vector<uint32_t> members;   ///< voxels the record stands for (1, or an aggregate's count;
-                                     ///< 0 for the lighter of a blended block's two levels)
+    template <class T>
+    using Array = std::vector<T, HugePageAllocator<T>>;
+    Array<glm::vec3> viewPos;  ///< voxel centre in view space (eye at origin, +z forward)
+    Array<float> distance;     ///< |viewPos|, world units
+    Array<float> sigma;        ///< extinction per voxel length (σ_k·h; × its weight when blended)
+    Array<glm::vec3> color;    ///< emitted colour c_k (σ-weighted mean for an aggregate)
+    Array<float> spread;       ///< aggregate: projected second moment about the centroid
+                               ///< beyond a full cell's, isotropic (trace/2), px²; 0 for a voxel
+    Array<uint32_t> members;   ///< voxels the record stands for (1, or an aggregate's count;
+                               ///< 0 for the lighter of a blended block's two levels)
     int64_t slabBegin = 0;           ///< first slab of the window: slab = floor(distance / (h·slabThickness))
     int64_t slabEnd = 0;             ///< one past the last slab
     size_t size() const { return viewPos.size(); }

@@ -256,7 +256,8 @@ TEST(TileCompositor, SameImageForAnyThreadCount) {
     ASSERT_EQ(one.pixels, two.pixels);
 }
 
-// projectBatch is projectVoxel over the batch, in order, with the window's slab and depth.
+// projectBatch is projectVoxel over the batch, in order, with the window's slab and depth, packed
+// into the window's arrays (record, order key, depth, members, extra), and counted by kind.
 TEST(ProjectBatch, EqualsProjectVoxelOneByOne) {
     const Camera camera = testCamera(64);
     // h = 0.1: projected spacing 3 px at z = 4, 0.27 px at z = 44: points and splats.
@@ -273,25 +274,40 @@ TEST(ProjectBatch, EqualsProjectVoxelOneByOne) {
         batch.spread.push_back(i % 3 == 0 ? u(rng) : 0.f);
         batch.members.push_back(1 + uint32_t(i % 5));
     }
-    batch.slabBegin = 0, batch.slabEnd = 200;
-    PrimitiveBuffer buffer(7000);  // larger than the batch: only the first 5000 are this window
-    const std::span<const Primitive> prims = projectBatch(batch, ctx, buffer);
-    ASSERT_EQ(prims.size(), batch.size());
+    batch.slabBegin = 3, batch.slabEnd = 200;
+    ProjectedWindow window;
+    window.resize(7000);  // larger than the batch: only the first 5000 are this window
+    const ProjectionCounts counts = projectBatch(batch, ctx, window);
+    ASSERT_EQ(window.size, batch.size());
+    ASSERT_EQ(window.slabBase, 3);
     int kinds[6] = {};
+    uint64_t drawnVoxels = 0;
     for (size_t i = 0; i < batch.size(); ++i) {
         const Primitive q = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
-        const Primitive& p = prims[i];
+        const PrimitiveRecord& p = window.records[i];
         ++kinds[int(p.kind)];
+        drawnVoxels += q.kind != PrimitiveKind::Culled ? batch.members[i] : 0;
+        const bool point = q.kind == PrimitiveKind::Point;
         ASSERT_EQ(p.kind, q.kind) << i;
         ASSERT_EQ(p.centre, q.centre) << i;
-        ASSERT_EQ(p.variance, q.variance) << i;
-        ASSERT_EQ(p.total, q.total) << i;
-        ASSERT_EQ(p.conic, q.conic) << i;
-        ASSERT_EQ(p.scale, q.scale) << i;
-        ASSERT_EQ(p.members, batch.members[i]) << i;
-        ASSERT_EQ(p.depth, batch.distance[i]) << i;
-        ASSERT_EQ(p.slab, std::clamp<int64_t>(int64_t(std::floor(batch.distance[i] / ctx.slabLength)), 0, 199)) << i;
+        ASSERT_EQ(p.shape, point ? glm::vec3(q.pointInvVariance, q.total, q.pointNorm) : q.conic) << i;
+        ASSERT_EQ(p.scale, point ? q.pointRadius2 : q.scale) << i;
+        ASSERT_EQ(p.sin2Alpha, q.sin2Alpha) << i;
+        ASSERT_EQ(p.color, q.color) << i;
+        ASSERT_EQ(p.hasExactMap, q.hasExactMap) << i;
+        ASSERT_TRUE(p.range.x0 == q.range.x0 && p.range.y0 == q.range.y0 && p.range.x1 == q.range.x1 &&
+                    p.range.y1 == q.range.y1) << i;
+        if (q.hasExactMap && needsExtra(q.kind)) ASSERT_EQ(window.extra[i].exactMap.A, q.exactMap.A) << i;
+        if (needsExtra(q.kind)) ASSERT_EQ(window.extra[i].viewPos, q.viewPos) << i;
+        ASSERT_EQ(window.members[i], batch.members[i]) << i;
+        ASSERT_EQ(window.depth[i], batch.distance[i]) << i;
+        const int64_t slab = std::clamp<int64_t>(int64_t(std::floor(batch.distance[i] / ctx.slabLength)), 3, 199);
+        ASSERT_EQ(p.slab, uint32_t(slab - 3)) << i;
+        const bool drawn = q.kind != PrimitiveKind::Culled && !q.range.empty();
+        ASSERT_EQ(window.order[i], drawn ? uint32_t(slab - 3) * 2 + (point ? 0 : 1) : ProjectedWindow::kNotDrawn) << i;
     }
+    EXPECT_EQ(counts.points, uint64_t(kinds[int(PrimitiveKind::Point)]));
+    EXPECT_EQ(counts.drawnVoxels, drawnVoxels);
     EXPECT_GT(kinds[int(PrimitiveKind::Point)], 100);
     EXPECT_GT(kinds[int(PrimitiveKind::Splat)] + kinds[int(PrimitiveKind::SplatExactIndex)], 100);
 }

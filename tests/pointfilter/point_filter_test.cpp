@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <random>
 
 #include "footprint/ellipse.h"
 #include "footprint/kernel.h"
@@ -13,6 +14,7 @@
 #include "footprint/screen_kernel.h"
 #include "footprint/tables.h"
 #include "pointfilter/point_filter.h"
+#include "render/project_modes.h"
 
 namespace vdbsplat {
 namespace {
@@ -156,6 +158,71 @@ TEST(PointFilter, NonFiniteInputGivesNoPixels) {
     const PointFilterTable t;
     EXPECT_EQ(rasterizePoint(t, {std::nan(""), 1.0}, 1.5).nx, 0);
     EXPECT_EQ(rasterizePoint(t, {1e300, 1.0}, 1.5).nx, 0);
+}
+
+// The filter set up once at projection (PointSetup) gives rasterizePoint's footprint and weights
+// bit for bit, pixel by pixel: float centres (what the renderer stores) anywhere in a pixel and
+// on pixel centres and edges, variances from --mode none's 1/36 to the 3.5 px cap, and ones so
+// small that no pixel centre lies within r_s (rasterizePoint's one-pixel fallback).
+TEST(PointFilter, SetupMatchesTheFootprint) {
+    const PointFilterTable& t = standardPointFilterTable();
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    int checked = 0, fallbacks = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const int edge = trial % 8;  // some centres exactly on pixel centres or pixel edges
+        const float fx = edge == 0 ? 0.5f : edge == 1 ? 0.f : u(rng), fy = edge == 2 ? 0.5f : edge == 3 ? 0.f : u(rng);
+        const float cx = float(-20 + int(1100 * u(rng))) + fx, cy = float(-20 + int(700 * u(rng))) + fy;
+        const float v = trial % 5 == 0 ? float(1e-4 + 1e-3 * u(rng))                    // tiny: the fallback
+                        : trial % 5 == 1 ? float(kNearestPixelVariance)
+                                         : float(pointFilterVariance(3.0 * u(rng), trial % 2 ? 0.1 : 1.0));
+        const PointFootprint fp = rasterizePoint(t, PixelCoord(cx, cy), v);
+        const PointSetup s = setupPoint(t, PixelCoord(cx, cy), v);
+        ASSERT_EQ(s.x0, fp.x0);
+        ASSERT_EQ(s.y0, fp.y0);
+        ASSERT_EQ(s.nx, fp.nx);
+        ASSERT_EQ(s.ny, fp.ny);
+        fallbacks += s.norm == 1.0f && s.invVariance == 0.0f;
+        for (int iy = 0; iy < fp.ny; ++iy)
+            for (int ix = 0; ix < fp.nx; ++ix, ++checked)
+                ASSERT_EQ(pointWeight(t, s, cx, cy, fp.x0 + ix, fp.y0 + iy), fp.at(ix, iy))
+                    << "centre " << cx << ", " << cy << " V " << v << " pixel " << ix << ", " << iy;
+    }
+    EXPECT_GT(checked, 100000);
+    EXPECT_GT(fallbacks, 100);
+    EXPECT_TRUE(setupPoint(t, {std::nan(""), 1.0}, 1.5).empty());
+    EXPECT_TRUE(setupPoint(t, {1e300, 1.0}, 1.5).empty());
+    EXPECT_TRUE(setupPoint(t, {1.0, 1.0}, 0.0).empty());
+}
+
+// The vector setup (setupPointVector: both axes' weights in one vector, the terms row by row in
+// vectors, the sum in the scalar order) is the scalar setup bit for bit, for float centres (what
+// the renderer stores), including centres at and near 0, past the image's edges, and the fallback.
+TEST(PointFilter, VectorSetupEqualsTheScalarSetup) {
+    const PointFilterTable& t = standardPointFilterTable();
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    int fallbacks = 0;
+    for (int trial = 0; trial < 50000; ++trial) {
+        const int kind = trial % 10;
+        float cx = float(-30 + int(2000 * u(rng))) + u(rng), cy = float(-30 + int(1200 * u(rng))) + u(rng);
+        if (kind == 0) cx = 1e-6f * u(rng), cy = -1e-7f * u(rng);  // at and near the origin
+        if (kind == 1) cx = std::floor(cx) + 0.5f;                  // on a pixel centre
+        const float v = kind == 2 ? float(1e-4 + 1e-3 * u(rng))
+                        : kind == 3 ? float(kNearestPixelVariance)
+                                    : float(pointFilterVariance(4.0 * u(rng), trial % 2 ? 0.1 : 1.0));
+        const PointSetup a = setupPoint(t, PixelCoord(cx, cy), v), b = setupPointVector(t, PixelCoord(cx, cy), v);
+        ASSERT_EQ(a.x0, b.x0) << trial;
+        ASSERT_EQ(a.y0, b.y0) << trial;
+        ASSERT_EQ(a.nx, b.nx) << trial;
+        ASSERT_EQ(a.ny, b.ny) << trial;
+        ASSERT_EQ(a.invVariance, b.invVariance) << trial;
+        ASSERT_EQ(a.radius2, b.radius2) << trial;
+        ASSERT_EQ(a.norm, b.norm) << "trial " << trial << " centre " << cx << ", " << cy << " V " << v;
+        fallbacks += a.invVariance == 0.0f && !a.empty();
+    }
+    EXPECT_GT(fallbacks, 100);
+    EXPECT_TRUE(setupPointVector(t, {std::nan(""), 1.0}, 1.5).empty());
 }
 
 }  // namespace

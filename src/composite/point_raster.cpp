@@ -1,0 +1,132 @@
+// composite/point_raster.cpp — a point's filter over one tile with Google Highway (see
+// point_raster.h). Compiled once per SIMD target (foreach_target.h); HWY_DYNAMIC_DISPATCH picks
+// the best the CPU supports at run time. Built with -ffp-contract=off (CMakeLists.txt): a fused
+// multiply-add would round differently from the scalar oracle.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "composite/point_raster.cpp"
+#include <hwy/foreach_target.h>  // must come before highway.h
+#include <hwy/highway.h>
+
+#include <algorithm>
+
+#include "composite/point_raster.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace vdbsplat {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+constexpr int kStride = 16;  // tile row stride (kTileSize)
+
+/// PointFilterTable::weight on every lane: 0 where !(x < maxX); else the linear lookup, with
+/// weight()'s float operations (two gathers: cheaper here than a scalar lookup per pixel row
+/// and column).
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V Weight(D d, const PointFilterTable& table, V x) {
+    const hn::RebindToSigned<D> di;
+    const auto valid = hn::Lt(x, hn::Set(d, PointFilterTable::maxX()));  // false for NaN
+    const V t = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, table.indexScale()));
+    const auto k = hn::Min(hn::ConvertTo(di, t), hn::Set(di, PointFilterTable::kIntervals - 1));
+    const V w = hn::Sub(t, hn::ConvertTo(d, k));
+    const V v0 = hn::GatherIndex(d, table.values(), k), v1 = hn::GatherIndex(d, table.values() + 1, k);
+    return hn::IfThenElseZero(valid, hn::Add(v0, hn::Mul(w, hn::Sub(v1, v0))));
+}
+
+template <class D>
+void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
+    using V = hn::Vec<D>;
+    constexpr int N = int(hn::MaxLanes(D()));
+    const hn::RebindToSigned<D> di;
+    const PointFilterTable& table = *p.table;
+    // The tile's columns in vectors of N: the first and last that hold footprint pixels.
+    const int c0 = (p.x0 - tile.x0) / N * N, c1 = (p.x1 - tile.x0) / N * N;
+    // Per column and per row of the footprint's part in the tile (once per point and tile): the
+    // squared offset and its weight, both axes in one vector of 16 (lanes 0–7 the columns from
+    // p.x0, 8–15 the rows from p.y0: one pair of gathers), then put on the tile's lanes.
+    alignas(64) float sq[16], g[16];
+    {
+        const hn::CappedTag<float, 16> d16;
+        const hn::RebindToSigned<decltype(d16)> di16;
+        constexpr int N16 = int(hn::MaxLanes(d16));
+        for (int k = 0; k < 16; k += N16) {
+            const auto lane = hn::Iota(di16, k);
+            const auto isX = hn::Lt(lane, hn::Set(di16, 8));
+            const auto pixel = hn::IfThenElse(isX, hn::Add(lane, hn::Set(di16, p.x0)), hn::Add(lane, hn::Set(di16, p.y0 - 8)));
+            const auto centre = hn::IfThenElse(hn::RebindMask(d16, isX), hn::Set(d16, p.cx), hn::Set(d16, p.cy));
+            const auto off = hn::Sub(hn::Add(hn::ConvertTo(d16, pixel), hn::Set(d16, 0.5f)), centre);
+            const auto off2 = hn::Mul(off, off);
+            hn::Store(off2, d16, sq + k);
+            hn::Store(Weight(d16, table, hn::Mul(off2, hn::Set(d16, p.invVariance))), d16, g + k);
+        }
+    }
+    // The columns on the tile's lanes: lanes past the footprint's part hold other columns' values
+    // (or zeros), masked off below.
+    alignas(64) float dx2s[kStride + 8] = {}, gxs[kStride + 8] = {};
+    const int at = p.x0 - tile.x0;
+    std::copy_n(sq, 8, dx2s + at), std::copy_n(g, 8, gxs + at);
+    const V eps = hn::Set(d, p.epsilon), rs2 = hn::Set(d, p.radius2), total = hn::Set(d, p.total),
+            norm = hn::Set(d, p.norm);
+    const V cr = hn::Set(d, p.color.x), cg = hn::Set(d, p.color.y), cb = hn::Set(d, p.color.z);
+    const auto before = hn::Set(di, p.x0 - tile.x0 - 1), after = hn::Set(di, p.x1 - tile.x0 + 1);
+    for (int y = p.y0; y <= p.y1; ++y) {
+        const int ly = y - p.y0, row = (y - tile.y0) * kStride;
+        const V gy = hn::Set(d, g[8 + ly]), vdy2 = hn::Set(d, sq[8 + ly]);
+        for (int c = c0; c <= c1; c += N) {
+            const auto col = hn::Iota(di, c);
+            const auto inRange = hn::RebindMask(d, hn::And(hn::Gt(col, before), hn::Lt(col, after)));
+            const V dx2 = hn::Load(d, dx2s + c);
+            const auto mask = hn::And(hn::And(inRange, hn::Ge(hn::Load(d, tile.T + row + c), eps)),
+                                      hn::Lt(hn::Add(dx2, vdy2), rs2));
+            if (hn::AllFalse(d, mask)) continue;
+            const V tau = hn::Mul(total, hn::Mul(hn::Mul(hn::Load(d, gxs + c), gy), norm));
+            float* const pt = tile.tau + row + c;
+            float* const pr = tile.er + row + c;
+            float* const pg = tile.eg + row + c;
+            float* const pb = tile.eb + row + c;
+            const V t0 = hn::Load(d, pt), r0v = hn::Load(d, pr), g0 = hn::Load(d, pg), b0 = hn::Load(d, pb);
+            hn::Store(hn::IfThenElse(mask, hn::Add(t0, tau), t0), d, pt);
+            hn::Store(hn::IfThenElse(mask, hn::Add(r0v, hn::Mul(tau, cr)), r0v), d, pr);
+            hn::Store(hn::IfThenElse(mask, hn::Add(g0, hn::Mul(tau, cg)), g0), d, pg);
+            hn::Store(hn::IfThenElse(mask, hn::Add(b0, hn::Mul(tau, cb)), b0), d, pb);
+        }
+    }
+}
+
+void DrawPoint(const PointRaster& p, const SlabTile& tile) {
+    if (p.x0 > p.x1 || p.y0 > p.y1) return;
+    DrawPointFor(hn::CappedTag<float, kStride>(), p, tile);
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace vdbsplat
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace vdbsplat {
+
+HWY_EXPORT(DrawPoint);
+
+void drawPointVector(const PointRaster& p, const SlabTile& tile) { HWY_DYNAMIC_DISPATCH(DrawPoint)(p, tile); }
+
+void drawPointScalar(const PointRaster& p, const SlabTile& tile) {
+    constexpr int kStride = 16;
+    const PointFilterTable& table = *p.table;
+    for (int y = p.y0; y <= p.y1; ++y) {
+        const float dy = PointSetup::offset(y, p.cy), dy2 = dy * dy;
+        const float gy = table.weight(dy2 * p.invVariance);
+        for (int x = p.x0; x <= p.x1; ++x) {
+            const int i = (y - tile.y0) * kStride + (x - tile.x0);
+            if (!(tile.T[i] >= p.epsilon)) continue;
+            const float dx = PointSetup::offset(x, p.cx), dx2 = dx * dx;
+            const float w = dx2 + dy2 < p.radius2 ? table.weight(dx2 * p.invVariance) * gy : 0.0f;
+            const float tau = p.total * (w * p.norm);
+            tile.tau[i] += tau;
+            tile.er[i] += tau * p.color.x;
+            tile.eg[i] += tau * p.color.y;
+            tile.eb[i] += tau * p.color.z;
+        }
+    }
+}
+
+}  // namespace vdbsplat
+#endif  // HWY_ONCE

@@ -1,0 +1,84 @@
+// pointfilter/point_setup.cpp — setupPoint's footprint sum with Google Highway (see
+// point_filter.h, setupPointVector). Compiled once per SIMD target (foreach_target.h);
+// HWY_DYNAMIC_DISPATCH picks the best the CPU supports at run time. Built with
+// -ffp-contract=off (CMakeLists.txt): the scalar setup is the oracle, bit for bit.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "pointfilter/point_setup.cpp"
+#include <hwy/foreach_target.h>  // must come before highway.h
+#include <hwy/highway.h>
+
+#include "pointfilter/point_filter.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace vdbsplat {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+/// PointFilterTable::weight on every lane, with its float operations.
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V Weight(D d, const PointFilterTable& table, V x) {
+    const hn::RebindToSigned<D> di;
+    const auto valid = hn::Lt(x, hn::Set(d, PointFilterTable::maxX()));  // false for NaN
+    const V t = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, table.indexScale()));
+    const auto k = hn::Min(hn::ConvertTo(di, t), hn::Set(di, PointFilterTable::kIntervals - 1));
+    const V w = hn::Sub(t, hn::ConvertTo(d, k));
+    const V v0 = hn::GatherIndex(d, table.values(), k), v1 = hn::GatherIndex(d, table.values() + 1, k);
+    return hn::IfThenElseZero(valid, hn::Add(v0, hn::Mul(w, hn::Sub(v1, v0))));
+}
+
+PointSetup SetupPoint(const PointFilterTable& table, const PixelCoord& x, double variance) {
+    PointSetup s;
+    float invV = 0.0f, rs2 = 0.0f;
+    if (!pointSetupBox(x, variance, s, invV, rs2)) return s;
+    // Lanes 0–7: the columns' offsets; 8–15: the rows'. (i + ½) − c in float: one rounding of
+    // the exact difference, as setupPoint's double difference rounded to float is for a float c.
+    const hn::CappedTag<float, 16> d;
+    const hn::RebindToSigned<decltype(d)> di;
+    constexpr int N = int(hn::MaxLanes(d));
+    alignas(64) float sq[16], g[16];
+    for (int k = 0; k < 16; k += N) {
+        const auto lane = hn::Iota(di, k);
+        const auto isX = hn::Lt(lane, hn::Set(di, 8));
+        const auto index = hn::IfThenElse(isX, hn::Add(lane, hn::Set(di, s.x0)), hn::Add(lane, hn::Set(di, s.y0 - 8)));
+        const auto centre = hn::IfThenElse(hn::RebindMask(d, isX), hn::Set(d, float(x.x)), hn::Set(d, float(x.y)));
+        const auto off = hn::Sub(hn::Add(hn::ConvertTo(d, index), hn::Set(d, 0.5f)), centre);
+        const auto off2 = hn::Mul(off, off);
+        hn::Store(off2, d, sq + k);
+        hn::Store(Weight(d, table, hn::Mul(off2, hn::Set(d, invV))), d, g + k);
+    }
+    // Each row's terms (0 outside the circle and past nx), in one vector of 8, then the sum in
+    // setupPoint's order: adding +0 changes no sum.
+    const hn::CappedTag<float, 8> d8;
+    constexpr int N8 = int(hn::MaxLanes(d8));
+    alignas(64) float terms[kPointMaxSide * 8];
+    for (int k = 0; k < 8; k += N8) {
+        const auto gx = hn::Load(d8, g + k), dx2 = hn::Load(d8, sq + k);
+        const auto cols = hn::RebindMask(d8, hn::Lt(hn::Iota(hn::RebindToSigned<decltype(d8)>(), k),
+                                                    hn::Set(hn::RebindToSigned<decltype(d8)>(), s.nx)));
+        for (int iy = 0; iy < s.ny; ++iy) {
+            const auto in = hn::And(cols, hn::Lt(hn::Add(dx2, hn::Set(d8, sq[8 + iy])), hn::Set(d8, rs2)));
+            hn::Store(hn::IfThenElseZero(in, hn::Mul(gx, hn::Set(d8, g[8 + iy]))), d8, terms + iy * 8 + k);
+        }
+    }
+    float sum = 0.0f;
+    for (int iy = 0; iy < s.ny; ++iy)
+        for (int ix = 0; ix < s.nx; ++ix) sum += terms[iy * 8 + ix];
+    finishPointSetup(s, x, sum, invV, rs2);
+    return s;
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace vdbsplat
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace vdbsplat {
+
+HWY_EXPORT(SetupPoint);
+
+PointSetup setupPointVector(const PointFilterTable& table, const PixelCoord& x, double variance) {
+    return HWY_DYNAMIC_DISPATCH(SetupPoint)(table, x, variance);
+}
+
+}  // namespace vdbsplat
+#endif  // HWY_ONCE

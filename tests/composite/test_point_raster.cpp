@@ -1,0 +1,74 @@
+// tests/composite/test_point_raster.cpp — the point loop over one tile (composite/point_raster.h):
+// the Highway loop against the scalar loop, bit for bit, and the scalar loop against the point's
+// footprint from rasterizePoint (the filter DESIGN §4 defines), with pixels already finished.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <random>
+
+#include "composite/point_raster.h"
+#include "pointfilter/point_filter.h"
+
+namespace vdbsplat {
+namespace {
+
+struct SlabArrays {
+    alignas(64) std::array<float, 256> tau, er, eg, eb, T;
+    SlabTile tile(int x0, int y0) { return {tau.data(), er.data(), eg.data(), eb.data(), T.data(), x0, y0}; }
+};
+
+TEST(PointRaster, VectorLoopEqualsTheScalarLoop) {
+    const PointFilterTable& table = standardPointFilterTable();
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    constexpr float kEpsilon = 1e-4f;
+    int drawn = 0, skippedFinished = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        const int tx0 = 16 * int(4 * u(rng)), ty0 = 16 * int(4 * u(rng));  // the tile's first pixel
+        SlabArrays a, b;
+        for (size_t i = 0; i < 256; ++i) {
+            a.tau[i] = u(rng) < 0.3f ? 0.f : u(rng), a.er[i] = u(rng), a.eg[i] = u(rng), a.eb[i] = u(rng);
+            a.T[i] = u(rng) < 0.2f ? kEpsilon * u(rng) : u(rng);  // some pixels finished
+        }
+        b = a;
+        // A centre in or near the tile; variances of both low-passes and of --mode none.
+        const float cx = float(tx0) - 4.f + 24.f * u(rng), cy = float(ty0) - 4.f + 24.f * u(rng);
+        const float v = trial % 7 == 0 ? 1.f / 36.f : float(pointFilterVariance(2.5 * u(rng), trial % 2 ? 0.1 : 1.0));
+        const PointSetup s = setupPoint(table, PixelCoord(cx, cy), v);
+        if (s.empty()) continue;
+        PointRaster p;
+        p.cx = cx, p.cy = cy, p.invVariance = s.invVariance, p.radius2 = s.radius2, p.norm = s.norm;
+        p.total = 0.01f + 5.f * u(rng);
+        p.color = glm::vec3(u(rng), u(rng), u(rng));
+        p.x0 = std::max(s.x0, tx0), p.x1 = std::min(s.x0 + s.nx - 1, tx0 + 15);
+        p.y0 = std::max(s.y0, ty0), p.y1 = std::min(s.y0 + s.ny - 1, ty0 + 15);
+        p.epsilon = kEpsilon;
+        p.table = &table;
+        const SlabArrays before = a;
+        drawPointScalar(p, a.tile(tx0, ty0));
+        drawPointVector(p, b.tile(tx0, ty0));
+        for (size_t i = 0; i < 256; ++i) {
+            ASSERT_EQ(a.tau[i], b.tau[i]) << "trial " << trial << " pixel " << i;
+            ASSERT_EQ(a.er[i], b.er[i]) << trial;
+            ASSERT_EQ(a.eg[i], b.eg[i]) << trial;
+            ASSERT_EQ(a.eb[i], b.eb[i]) << trial;
+        }
+        // The scalar loop deposits total · w with rasterizePoint's w, on live pixels only.
+        const PointFootprint fp = rasterizePoint(table, PixelCoord(cx, cy), v);
+        for (int y = ty0; y < ty0 + 16; ++y)
+            for (int x = tx0; x < tx0 + 16; ++x) {
+                const size_t i = size_t(y - ty0) * 16 + size_t(x - tx0);
+                const bool inside = x >= fp.x0 && x < fp.x0 + fp.nx && y >= fp.y0 && y < fp.y0 + fp.ny;
+                const bool live = before.T[i] >= kEpsilon;
+                const float tau = inside && live ? p.total * fp.at(x - fp.x0, y - fp.y0) : 0.f;
+                ASSERT_EQ(a.tau[i], before.tau[i] + tau) << trial;
+                ASSERT_EQ(a.er[i], before.er[i] + tau * p.color.x) << trial;
+                drawn += tau > 0.f, skippedFinished += inside && !live;
+            }
+    }
+    EXPECT_GT(drawn, 20000);
+    EXPECT_GT(skippedFinished, 1000);
+}
+
+}  // namespace
+}  // namespace vdbsplat
