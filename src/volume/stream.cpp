@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <array>
 #include <cmath>
 #include <optional>
@@ -177,19 +178,26 @@ void VoxelStream::lodLevel(Block& b) const {
         if (ell >= 1.0) b.lodLevel = int(std::min(std::floor(ell), 3.0));
         return;
     }
-    // Blended: the block passes from level k − 1 to level k while x = g(ℓ) goes from k to k + 1,
-    // with g(ℓ) = ℓ up to ℓ = 1.5 and ℓ + lodLead from ℓ = 2.5 on (linear between, so g is
-    // monotone and the passages do not overlap). With the default lead 1: voxels → 2³ over
-    // ℓ ∈ [1, 1.75) (never coarser than the switching rule), 2³ → 4³ over [1.75, 2.25), 4³ → 8³
-    // over [2.25, 3) (all 8³ where they become admissible).
-    const double x = ell + options_.lodLead * std::clamp(ell - 1.5, 0.0, 1.0);
-    if (!(x >= 1.0)) return;
-    if (x >= 4.0) {
-        b.lodLevel = 3;
+    // Blended: the block passes from level k − 1 to level k while ℓ crosses passage k (kLodPassage):
+    // voxels → 2³ over ℓ ∈ [1, 1.75) (2³ cells never come in before they are admissible: coarser
+    // cells there flicker more), 2³ → 4³ over [1.75, 2) and 4³ → 8³ over [2.25, 3) (each ends
+    // where the switching rule switches, so a block is never drawn finer than by that rule past
+    // the first passage: its cost stays the switching rule's, plus the lighter level's records).
+    // x = k + progress inside passage k; k between passages.
+    double x = 1.0;
+    for (int k = 1; k <= 3; ++k) {
+        const auto [begin, end] = kLodPassage[k - 1];
+        if (ell >= end) x = double(k + 1);
+        else if (ell >= begin) x = double(k) + (ell - begin) / (end - begin);
+    }
+    if (!(ell > kLodPassage[0].first)) return;  // all voxels (also for a NaN ℓ)
+    const double level = std::floor(x), progress = x - level;
+    if (progress == 0.0) {  // between passages: all at level x − 1
+        b.lodLevel = int(level) - 1;
         return;
     }
-    b.lodLevel = int(std::floor(x));
-    b.lodFine = float(1.0 - (x - double(b.lodLevel)));
+    b.lodLevel = int(level);
+    b.lodFine = float(1.0 - progress);
 }
 
 namespace {

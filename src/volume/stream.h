@@ -22,6 +22,7 @@
 #pragma once
 #include <functional>
 #include <glm/glm.hpp>
+#include <utility>
 #include <vector>
 
 #include "camera/camera.h"
@@ -63,6 +64,13 @@ struct VoxelBatch {
 /// against the reference, each level against --lod 0): ratios 0.22–0.54 cost −0.7…+0.5 dB,
 /// ratios 1.1–2.3 cost −0.4…−8.7 dB (docs/performance.md, session 3).
 inline constexpr double kLodMaxSpreadRatio = 0.75;
+/// Level of detail, blended: passage k (ℓ from .first to .second, ℓ = the admissible level of a
+/// block, log₂ of the cell size in voxels) takes a block from level k − 1 to level k (voxels,
+/// 2³, 4³, 8³). The first starts where 2³ becomes admissible and is long (a zoom passes it over
+/// several frames: 2³ cells are about a pixel, and coarser or quicker they flicker more); the
+/// others end where the switching rule switches, so past the first a block costs at most the
+/// switching rule's records plus those of its lighter level (docs/performance.md, session 5).
+inline constexpr std::pair<double, double> kLodPassage[3] = {{1.0, 1.75}, {1.75, 2.0}, {2.25, 3.0}};
 
 struct StreamOptions {
     double slabThickness = 1.0;  ///< slab thickness in voxels (points are summed within one slab)
@@ -86,12 +94,6 @@ struct StreamOptions {
     /// split between them, so no cell pops during a zoom; false: the level switches at once where
     /// it becomes admissible (the rule before session 5; for tests and measurement).
     bool lodBlend = true;
-    /// Blended: how many levels earlier than the switching rule 4³ and 8³ cells come in (1: a block
-    /// is all 8³ cells where they become admissible; 2³ cells always come in only once admissible).
-    /// Aggregates that add only the spread beyond a full cell's own (emitCells) no longer blur by
-    /// the spread the admissibility rule limits; measured, 1 is better than ½ or ¾ in every far
-    /// cell of the fidelity table and in both zoom animations (docs/animation.md, session 5).
-    double lodLead = 1.0;
     /// Blended, voxels → 2³: each 2³ cell passes over this fraction of its block's passage, placed
     /// by a hash of the cell, so only that fraction of a passing block is drawn twice (1: all).
     double lodVoxelRamp = 0.1;
