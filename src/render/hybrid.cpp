@@ -33,6 +33,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
                 const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
     StreamOptions streamOptions = settings.stream;
     streamOptions.lodCellPx = pass.lodPx;
+    streamOptions.lodBlend = settings.lodBlend;
     streamOptions.pointPrefilterVariance = pass.prefilterVariance;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point ? INFINITY
                                  : drawsOnlySplats(settings.mode)   ? 0.0

@@ -120,6 +120,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["subpixels"] = modeFixesFilterOrder(mode) ? 1 : subpixels;
     j["show_primitives"] = showPrimitives;
     j["lod"] = mode == RenderMode::None ? 0.0 : lodPx;
+    if (!lodBlend) j["lod_blend"] = false;  // absent when on: default outputs unchanged
     j["simd"] = simd;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
     if (shading.active()) j["shading"] = shading.toJson();  // absent when off: unshaded outputs unchanged

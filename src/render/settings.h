@@ -96,6 +96,10 @@ struct RenderSettings {
     /// cap the spread a cell adds beside the points' filter decides (kLodMaxSpreadRatio,
     /// volume/stream.h), so an 8³ cell of 0.15 px voxels is not (docs/performance.md, session 3).
     double lodPx = 1.25;
+    /// Level of detail blended from one level to the next as the camera moves (no pop in a zoom;
+    /// volume/stream.h kLodPassage); false: each block switches at once where a level becomes
+    /// admissible (cheaper where blocks pass from voxels to 2³ cells; for still images).
+    bool lodBlend = true;
     /// Splats through the vector loop (Highway, polynomial footprint); false: the scalar table
     /// path it is tested against (same image to ~1e−6; for measuring).
     bool simd = true;

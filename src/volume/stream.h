@@ -92,7 +92,7 @@ struct StreamOptions {
     /// Level of detail, blended (docs/performance.md, "Level of detail"): a block passes from one
     /// level to the next continuously as the camera moves, drawn at both with its optical depth
     /// split between them, so no cell pops during a zoom; false: the level switches at once where
-    /// it becomes admissible (the rule before session 5; for tests and measurement).
+    /// it becomes admissible (the rule before session 5; `--lod-blend off`, RenderSettings::lodBlend).
     bool lodBlend = true;
     /// Blended, voxels → 2³: each 2³ cell passes over this fraction of its block's passage, placed
     /// by a hash of the cell, so only that fraction of a passing block is drawn twice (1: all).

@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 
 /// The render flags every rendering command shares (render_flags.cpp declares them once).
 const std::vector<std::string> kShared{
-    "--grid",    "--tf",        "--size",         "--up",          "--view-dir",  "--threshold", "--lod",
+    "--grid",    "--tf",        "--size",         "--up",          "--view-dir",  "--threshold", "--lod", "--lod-blend",
     "--footprint", "--filter-order", "--subpixels", "--simd",      "--threads",   "--shading",
     "--ambient", "--diffuse",   "--specular",     "--shininess",   "--light",     "--gradient-opacity",
     "--emission", "--emission-map", "--emission-scale", "--kelvin"};
@@ -161,6 +161,7 @@ TEST_F(CliFlags, SharedFlagsAreParsedAlike) {
     const std::vector<std::pair<std::string, std::string>> bad = {
         {"--lod -1", "--lod"},
         {"--lod nan", "--lod"},
+        {"--lod-blend maybe", "--lod-blend"},
         {"--lod 1 --lod 2", "--lod: given more than once"},
         {"--size 10x", "--size"},
         {"--size 0x10", "--size"},

@@ -402,6 +402,30 @@ TEST(Forward, LevelOfDetailKeepsTheFarImage) {
 // The medium is thin enough (σ = 1e−4 per voxel, peak alpha 0.5 %) that alpha's own curvature,
 // α ≈ τ − τ²/2, stays under the bound: coarse cells deposit their τ less evenly than the voxels
 // (measured −6.1e−5; at σ = 1e−3 it is −4.8e−4, ten times the τ², where the energy is the same).
+// --lod-blend off (RenderSettings::lodBlend) reaches the stream: at a view in a passage between
+// two aggregate levels the blended rule draws the block at both levels, the switching rule at
+// one, so it draws fewer points; both keep the far image.
+TEST(Forward, LevelOfDetailBlendCanBeTurnedOff) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    int fewer = 0;
+    for (const double distance : {3.0, 5.0, 6.0, 8.0, 12.0}) {
+        RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        RenderStats blended, switching;
+        const Image a = renderWith(marschnerLobb(), tf, s, &blended);
+        s.lodBlend = false;
+        const Image b = renderWith(marschnerLobb(), tf, s, &switching);
+        const double psnr = compareImages(a, b).psnr;
+        std::printf("  distance %.0f: blended %llu points, switching %llu points, %.1f dB apart\n", distance,
+                    (unsigned long long)blended.points, (unsigned long long)switching.points, psnr);
+        EXPECT_LE(switching.points, blended.points) << "distance " << distance;
+        EXPECT_EQ(switching.culled, blended.culled);
+        EXPECT_GT(psnr, 40.0) << "distance " << distance;
+        if (switching.points < blended.points) ++fewer;
+        EXPECT_TRUE(s.toJson().contains("lod_blend"));
+    }
+    EXPECT_GE(fewer, 2);  // views inside a passage
+}
+
 TEST(Forward, LevelOfDetailKeepsTheEnergy) {
     const TransferFunction tf = constantTf(0.0001f);
     RenderSettings s = settingsFor(RenderMode::Hybrid, 6.0);
@@ -426,7 +450,7 @@ TEST(Forward, LevelOfDetailAggregatesHalfPixelVoxels) {
     RenderSettings s = settingsFor(RenderMode::Hybrid, 2.0);  // 96²: Marschner–Lobb voxels at ≈ 0.55 px
     RenderStats on, switching, off;
     const Image a = renderWith(marschnerLobb(), tf, s, &on);
-    s.stream.lodBlend = false;
+    s.lodBlend = false;
     const Image c = renderWith(marschnerLobb(), tf, s, &switching);
     s.lodPx = 0.0;
     const Image b = renderWith(marschnerLobb(), tf, s, &off);
@@ -495,7 +519,7 @@ TEST(Forward, ZoomStepsAcrossLevelChangesAreSmooth) {
         RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
         Frame f;
         f.blended = renderWith(marschnerLobb(), tf, s);
-        s.stream.lodBlend = false;
+        s.lodBlend = false;
         f.switching = renderWith(marschnerLobb(), tf, s);
         s.lodPx = 0.0;
         f.none = renderWith(marschnerLobb(), tf, s);
