@@ -7,6 +7,8 @@
 #include <hwy/foreach_target.h>  // must come before highway.h
 #include <hwy/highway.h>
 
+#include "pointfilter/point_weight-inl.h"
+
 #include <algorithm>
 
 #include "composite/point_raster.h"
@@ -18,19 +20,6 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 constexpr int kStride = 16;  // tile row stride (kTileSize)
 
-/// PointFilterTable::weight on every lane: 0 where !(x < maxX); else the linear lookup, with
-/// weight()'s float operations (two gathers: cheaper here than a scalar lookup per pixel row
-/// and column).
-template <class D, class V = hn::Vec<D>>
-HWY_INLINE V Weight(D d, const PointFilterTable& table, V x) {
-    const hn::RebindToSigned<D> di;
-    const auto valid = hn::Lt(x, hn::Set(d, PointFilterTable::maxX()));  // false for NaN
-    const V t = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, table.indexScale()));
-    const auto k = hn::Min(hn::ConvertTo(di, t), hn::Set(di, PointFilterTable::kIntervals - 1));
-    const V w = hn::Sub(t, hn::ConvertTo(d, k));
-    const V v0 = hn::GatherIndex(d, table.values(), k), v1 = hn::GatherIndex(d, table.values() + 1, k);
-    return hn::IfThenElseZero(valid, hn::Add(v0, hn::Mul(w, hn::Sub(v1, v0))));
-}
 
 template <class D>
 void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
@@ -56,7 +45,7 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
             const auto off = hn::Sub(hn::Add(hn::ConvertTo(d16, pixel), hn::Set(d16, 0.5f)), centre);
             const auto off2 = hn::Mul(off, off);
             hn::Store(off2, d16, sq + k);
-            hn::Store(Weight(d16, table, hn::Mul(off2, hn::Set(d16, p.invVariance))), d16, g + k);
+            hn::Store(PointWeight(d16, table, hn::Mul(off2, hn::Set(d16, p.invVariance))), d16, g + k);
         }
     }
     // The columns on the tile's lanes: lanes past the footprint's part hold other columns' values

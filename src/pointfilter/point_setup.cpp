@@ -7,6 +7,8 @@
 #include <hwy/foreach_target.h>  // must come before highway.h
 #include <hwy/highway.h>
 
+#include "pointfilter/point_weight-inl.h"
+
 #include "pointfilter/point_filter.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -14,17 +16,6 @@ namespace vdbsplat {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-/// PointFilterTable::weight on every lane, with its float operations.
-template <class D, class V = hn::Vec<D>>
-HWY_INLINE V Weight(D d, const PointFilterTable& table, V x) {
-    const hn::RebindToSigned<D> di;
-    const auto valid = hn::Lt(x, hn::Set(d, PointFilterTable::maxX()));  // false for NaN
-    const V t = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, table.indexScale()));
-    const auto k = hn::Min(hn::ConvertTo(di, t), hn::Set(di, PointFilterTable::kIntervals - 1));
-    const V w = hn::Sub(t, hn::ConvertTo(d, k));
-    const V v0 = hn::GatherIndex(d, table.values(), k), v1 = hn::GatherIndex(d, table.values() + 1, k);
-    return hn::IfThenElseZero(valid, hn::Add(v0, hn::Mul(w, hn::Sub(v1, v0))));
-}
 
 PointSetup SetupPoint(const PointFilterTable& table, const PixelCoord& x, double variance) {
     PointSetup s;
@@ -44,7 +35,7 @@ PointSetup SetupPoint(const PointFilterTable& table, const PixelCoord& x, double
         const auto off = hn::Sub(hn::Add(hn::ConvertTo(d, index), hn::Set(d, 0.5f)), centre);
         const auto off2 = hn::Mul(off, off);
         hn::Store(off2, d, sq + k);
-        hn::Store(Weight(d, table, hn::Mul(off2, hn::Set(d, invV))), d, g + k);
+        hn::Store(PointWeight(d, table, hn::Mul(off2, hn::Set(d, invV))), d, g + k);
     }
     // Each row's terms (0 outside the circle and past nx), in one vector of 8, then the sum in
     // setupPoint's order: adding +0 changes no sum.

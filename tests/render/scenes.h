@@ -3,6 +3,7 @@
 #include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 #include <openvdb/math/Transform.h>
 
+#include "render/settings.h"
 #include "volume/grid.h"
 #include "volume/transfer_function.h"
 
@@ -32,6 +33,17 @@ inline Volume boxVolume(openvdb::Coord lo, openvdb::Coord hi, float value = 1.f,
     grid->denseFill(openvdb::CoordBBox(lo, hi), value, true);
     grid->tree().voxelizeActiveTiles();
     return makeVolume(grid, "test-box");
+}
+
+/// Settings of @p mode at the standard framing, @p distance times the framing distance,
+/// @p size² pixels, a reference of 9 rays per pixel (3×3 jittered).
+inline RenderSettings settingsFor(RenderMode mode, double distance = 1.0, int size = 96) {
+    RenderSettings s;
+    s.mode = mode;
+    s.camera.width = s.camera.height = size;
+    s.camera.distance = distance;
+    s.spp = 9;
+    return s;
 }
 
 }  // namespace vdbsplat::test

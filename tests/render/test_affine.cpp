@@ -18,6 +18,8 @@
 namespace vdbsplat {
 namespace {
 
+using test::settingsFor;
+
 constexpr int kSize = 96;
 
 glm::dmat3 rotation(double angle, glm::dvec3 axis) {
@@ -47,15 +49,6 @@ Volume withTransform(openvdb::FloatGrid::Ptr grid, const glm::dmat3& A, const gl
 const openvdb::FloatGrid::Ptr& marschnerLobbGrid() {
     static const openvdb::FloatGrid::Ptr g = makeMarschnerLobb(41);
     return g;
-}
-
-RenderSettings settingsFor(RenderMode mode, double distance) {
-    RenderSettings s;
-    s.mode = mode;
-    s.camera.width = s.camera.height = kSize;
-    s.camera.distance = distance;
-    s.spp = 9;
-    return s;
 }
 
 double psnr(const Volume& v, const TransferFunction& tf, const RenderSettings& s, const Image& ref) {

@@ -138,11 +138,7 @@ Volume explosionVolume() {
 }
 
 RenderSettings explosionView(RenderMode mode, double distance) {
-    RenderSettings s;
-    s.mode = mode;
-    s.camera.width = s.camera.height = kSize;
-    s.camera.distance = distance;
-    s.spp = 9;
+    RenderSettings s = test::settingsFor(mode, distance, kSize);
     s.emission.grid = "temperature";
     s.emission.scale = 0.6;
     return s;

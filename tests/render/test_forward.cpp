@@ -25,6 +25,7 @@ namespace vdbsplat {
 namespace {
 
 using test::boxVolume;
+using test::settingsFor;
 
 constexpr int kSize = 96;
 /// Every forward mode, the study modes (ewa, swan, none; docs/modes.md) included.
@@ -32,15 +33,6 @@ constexpr RenderMode kForwardModes[] = {RenderMode::Hybrid, RenderMode::Point, R
                                         RenderMode::Ewa,    RenderMode::Swan,  RenderMode::None};
 /// Hybrid (postfilter) against the reference on the tubes at 96², --distance 1 and 0.5.
 constexpr double kTubesFloor = 35.0;  // measured 37.5 and 42.0 dB; prefilter: 26.3 and 25.9 dB
-
-RenderSettings settingsFor(RenderMode mode, double distance = 1.0) {
-    RenderSettings s;
-    s.mode = mode;
-    s.camera.width = s.camera.height = kSize;
-    s.camera.distance = distance;
-    s.spp = 9;
-    return s;
-}
 
 RenderSettings lookingAt(RenderMode mode, glm::dvec3 eye, glm::dvec3 lookAt, double fov = 30.0) {
     RenderSettings s = settingsFor(mode);
