@@ -5,17 +5,25 @@
 # scripts/fidelity.sh; smaller images by default. (The cost of shading: vdbsplat bench
 # --shading ct against --shading off, docs/shading.md.)
 # Reference images are cached in out/shading/ (delete them to re-render).
-# Usage: scripts/shading-fidelity.sh [--size WxH] [--spp N]      (default 256x256, 16 rays)
+# Usage: scripts/shading-fidelity.sh [--size WxH] [--spp N] [--shading MODE] [--volumes LIST]
+#   defaults: 256x256, 16 rays, --shading ct, checkerbox:grey and (if present) engine:ct-bone;
+#   LIST: comma-separated NAME:TF for volumes/NAME.vdb, e.g. the fidelity table's four at 400²:
+#   scripts/shading-fidelity.sh --size 400x400 --shading phong \
+#     --volumes checkerbox:grey,marschner-lobb:grey,engine:ct-bone,tubes:grey
 # Writes out/shading/shading.tsv and prints one line per row.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SIZE=256x256
 SPP=16
+SHADED=ct
+LIST=
 while [[ $# -gt 0 ]]; do
   case $1 in
     --size) SIZE=$2; shift 2 ;;
     --spp) SPP=$2; shift 2 ;;
-    *) echo "usage: scripts/shading-fidelity.sh [--size WxH] [--spp N]" >&2; exit 1 ;;
+    --shading) SHADED=$2; shift 2 ;;
+    --volumes) LIST=$2; shift 2 ;;
+    *) echo "usage: scripts/shading-fidelity.sh [--size WxH] [--spp N] [--shading MODE] [--volumes LIST]" >&2; exit 1 ;;
   esac
 done
 BIN=${BUILD_DIR:-build}/vdbsplat
@@ -24,7 +32,13 @@ VOLS=volumes
 mkdir -p "$OUT"
 [[ -f $VOLS/checkerbox.vdb ]] || VDBSPLAT=$BIN volumes/make-generated.sh checkerbox >/dev/null
 VOLUMES="checkerbox:grey"
-if [[ -f $VOLS/engine.vdb ]]; then
+if [[ -n $LIST ]]; then
+  VOLUMES=""
+  for entry in ${LIST//,/ }; do
+    if [[ -f $VOLS/${entry%%:*}.vdb ]]; then VOLUMES="$VOLUMES $entry"
+    else echo "shading-fidelity: $VOLS/${entry%%:*}.vdb absent (volumes/fetch.sh or volumes/make-generated.sh), skipping it" >&2; fi
+  done
+elif [[ -f $VOLS/engine.vdb ]]; then
   VOLUMES="$VOLUMES engine:ct-bone"
 else
   echo "shading-fidelity: $VOLS/engine.vdb absent (run volumes/fetch.sh engine), skipping the Engine rows" >&2
@@ -36,7 +50,7 @@ printf "volume\tdistance\tshading\tpsnr_db\tssim\trender_s\n" > $OUT/shading.tsv
 for entry in $VOLUMES; do
   vol=${entry%%:*} tf=${entry##*:}
   for d in 8 1 0.35; do
-    for shading in off ct; do
+    for shading in off $SHADED; do
       tag=${vol}_d${d}_${shading}_${SIZE}
       ref=$OUT/${tag}_reference.exr
       [[ -f $ref ]] || "$BIN" render $VOLS/$vol.vdb -o $ref --mode reference --tf $tf --distance $d \
