@@ -38,9 +38,8 @@ namespace vdbsplat::cli {
 namespace {
 
 /// Render flags bench does not take: it varies the mode and the distance itself (--modes,
-/// --distances), always frames the grid, and never renders the reference by default.
-const std::set<std::string> kNotBenchFlags{"--mode", "--distance", "--eye", "--look-at", "--fov",
-                                           "--spp", "--tables", "--max-voxels", "--show-primitives"};
+/// --distances), always frames the grid (--fov still sets the lens), and writes no image.
+const std::set<std::string> kNotBenchFlags{"--mode", "--distance", "--eye", "--look-at", "--show-primitives"};
 
 constexpr int kMaxRuns = 1000;
 constexpr int kMaxWarmup = 100;
@@ -246,9 +245,9 @@ int runBench(const Args& args) {
     }
 
     // The table.
-    std::printf("vdbsplat bench: %s (grid '%s', %llu active voxels), %dx%d, tf %s, threshold %g px, footprint %s, %s (%d subpixels)\n",
+    std::printf("vdbsplat bench: %s (grid '%s', %llu active voxels), %dx%d, fov %g, tf %s, threshold %g px, footprint %s, %s (%d subpixels)\n",
                 o.input.c_str(), volume.name.c_str(), (unsigned long long)volume.activeVoxels, o.base.camera.width,
-                o.base.camera.height, o.base.transferFunction.c_str(), o.base.threshold,
+                o.base.camera.height, o.base.camera.fovDeg, o.base.transferFunction.c_str(), o.base.threshold,
                 toString(o.base.footprint).c_str(), toString(o.base.filterOrder).c_str(), o.base.subpixels);
     std::printf("threads %d (machine %u), %d timed run%s + %d warmup per view and mode, interleaved\n\n", threads,
                 machine, o.runs, o.runs == 1 ? "" : "s", o.warmup);
@@ -301,6 +300,9 @@ int runBench(const Args& args) {
         j["filter_order"] = toString(o.base.filterOrder);
         j["subpixels"] = o.base.subpixels;
         j["fov"] = o.base.camera.fovDeg;
+        j["spp"] = o.base.spp;
+        j["tables"] = o.base.tablesDir;  // "": the shipped tables
+        j["max_voxels"] = o.base.maxActiveVoxels;
         nlohmann::ordered_json results = nlohmann::ordered_json::array();
         for (const Cell& c : cells) {
             nlohmann::ordered_json r;

@@ -172,6 +172,28 @@ TEST_F(BenchCli, ReferenceIsAllowedWithAWarning) {
     EXPECT_TRUE(j["results"][1].at("ratio_to_hybrid").is_number());
 }
 
+TEST_F(BenchCli, LensRaysTablesAndTheVoxelLimitReachTheRenders) {
+    const std::string json = path("flags.json");
+    const CliResult r = bench("--size 8x8 --runs 1 --warmup 0 --modes hybrid,reference --distances 1 --fov 50 "
+                              "--spp 4 --tables '" + std::string(VDBSPLAT_SOURCE_DIR) + "/tables' --max-voxels 100000 --json " + json);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.out.find("fov 50"), std::string::npos) << r.out;
+    const auto j = nlohmann::json::parse(slurp(json));
+    EXPECT_DOUBLE_EQ(j.at("fov").get<double>(), 50.0);
+    EXPECT_EQ(j.at("spp"), 4);
+    EXPECT_EQ(j.at("max_voxels"), 100000);
+    // The reference traced --spp rays per pixel (of the image and its filter border): 4× --spp 1's.
+    const std::string one = path("spp1.json");
+    ASSERT_EQ(bench("--size 8x8 --runs 1 --warmup 0 --modes reference --distances 1 --fov 50 --spp 1 --json " + one).rc, 0);
+    const auto j1 = nlohmann::json::parse(slurp(one));
+    EXPECT_EQ(j["results"][1].at("rays").get<uint64_t>(), 4 * j1["results"][0].at("rays").get<uint64_t>());
+    // The limit is the render's: a grid above it is refused before any timing, with no JSON.
+    const std::string none = path("limit.json");
+    expectError(bench("--runs 1 --max-voxels 10 --json " + none), "--max-voxels", none);
+    expectError(bench("--runs 1 --tables '" + path("nope") + "' --json " + none), "--tables", none);
+    expectError(bench("--runs 1 --fov 180 --json " + none), "--fov", none);
+}
+
 TEST_F(BenchCli, BadInput) {
     const std::string json = path("bad.json");
     const std::string j = " --size 16x16 --runs 1 --warmup 0 --json '" + json + "'";
