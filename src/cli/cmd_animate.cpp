@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "animation/camera_path.h"
+#include "animation/folder_record.h"
 #include "animation/frame_stats.h"
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -206,14 +207,7 @@ void removeMatching(const fs::path& dir, bool (*match)(const std::string&)) {
     for (const auto& p : doomed) fs::remove(p, ec);
 }
 
-/// FNV-1a 64 of @p text, as hex: a stable fingerprint of the frame cameras.
-std::string fnv1a(const std::string& text) {
-    uint64_t h = 1469598103934665603ull;
-    for (const unsigned char c : text) h = (h ^ c) * 1099511628211ull;
-    char buf[17];
-    std::snprintf(buf, sizeof buf, "%016llx", (unsigned long long)h);
-    return buf;
-}
+
 
 std::optional<nlohmann::json> readJson(const fs::path& p) {
     std::error_code ec;
@@ -416,19 +410,19 @@ int runAnimate(const Args& args) {
     nlohmann::json settingsJson = o.settings.toJson();
     settingsJson.erase("distance");
     nlohmann::json record = {{"input", inputId},       {"grid", volume.name}, {"settings", settingsJson},
-                             {"format", o.format},     {"frames", M},         {"cameras_fnv1a", fnv1a(cameraText)},
+                             {"format", o.format},     {"frames", M},         {"cameras_fnv1a", animation::cameraFingerprint(cameraText)},
                              {"reference", o.reference}};
     nlohmann::json refRecord = {{"input", inputId},     {"grid", volume.name},
                                 {"tf", o.settings.transferFunction}, {"spp", o.settings.spp},
                                 {"width", o.settings.camera.width},  {"height", o.settings.camera.height},
-                                {"frames", M},          {"cameras_fnv1a", fnv1a(cameraText)}};
+                                {"frames", M},          {"cameras_fnv1a", animation::cameraFingerprint(cameraText)}};
     const fs::path refDir = dir / "reference";
     if (o.resume) {
-        if (auto old = readJson(dir / "animation.json"); old && *old != record)
+        if (auto old = readJson(dir / "animation.json"); old && !animation::sameAnimation(*old, record, cameraText))
             throw Error(o.dir + ": --resume: the folder holds another animation (input, settings, path or "
                         "--reference differ; use --force to start afresh)");
         if (o.reference)
-            if (auto old = readJson(refDir / "reference.json"); old && *old != refRecord)
+            if (auto old = readJson(refDir / "reference.json"); old && !animation::sameAnimation(*old, refRecord, cameraText))
                 throw Error((refDir / "reference.json").string() +
                             ": --resume: reference frames of another animation (use --force to start afresh)");
     }

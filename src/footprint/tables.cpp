@@ -192,16 +192,6 @@ void writeFile(const std::filesystem::path& path, const std::string& bytes) {
 
 }  // namespace
 
-std::uint64_t fnv1a64(const void* data, std::size_t size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    for (std::size_t i = 0; i < size; ++i) {
-        h ^= p[i];
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
-
 // --- FootprintTable ------------------------------------------------------------
 
 FootprintTable::FootprintTable(std::vector<float> values, double maxAbsError, double errorBound)

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "footprint/footprint_poly.h"
+#include "util/fnv1a.h"  // fnv1a64: the payload checksum
 #include "footprint/kernel.h"
 
 namespace vdbsplat {
@@ -174,8 +175,5 @@ Tables loadOrBuildTables(const std::filesystem::path& dir = defaultTablesDir(),
 /// what buildTables() + serialize produce now. @return a one-line summary per table.
 /// @throw Error naming the file and the first differing byte on mismatch.
 std::vector<std::string> checkTables(const std::filesystem::path& dir);
-
-/// @brief FNV-1a 64-bit hash of @p size bytes (the payload checksum).
-std::uint64_t fnv1a64(const void* data, std::size_t size);
 
 }  // namespace vdbsplat

@@ -1,5 +1,6 @@
 // study/views.cpp — standard views, zoom ladder, list parsing and ids (see views.h).
 #include "study/views.h"
+#include "util/fnv1a.h"
 
 #include <cstdio>
 
@@ -65,12 +66,6 @@ std::string safeId(const std::string& text) {
     return id.empty() || id.find_first_not_of('_') == std::string::npos ? "volume" : id;
 }
 
-std::string fnv1a(const std::string& text) {
-    uint64_t h = 14695981039346656037ull;  // the FNV-1a 64 offset basis
-    for (const unsigned char c : text) h = (h ^ c) * 1099511628211ull;
-    char buf[17];
-    std::snprintf(buf, sizeof buf, "%016llx", (unsigned long long)h);
-    return buf;
-}
+std::string fnv1a(const std::string& text) { return fnv1aHex(text); }
 
 }  // namespace vdbsplat::study

@@ -297,8 +297,12 @@ TEST(ProjectBatch, EqualsProjectVoxelOneByOne) {
         ASSERT_EQ(p.hasExactMap, q.hasExactMap) << i;
         ASSERT_TRUE(p.range.x0 == q.range.x0 && p.range.y0 == q.range.y0 && p.range.x1 == q.range.x1 &&
                     p.range.y1 == q.range.y1) << i;
-        if (q.hasExactMap && needsExtra(q.kind)) ASSERT_EQ(window.extra[i].exactMap.A, q.exactMap.A) << i;
-        if (needsExtra(q.kind)) ASSERT_EQ(window.extra[i].viewPos, q.viewPos) << i;
+        if (q.hasExactMap && needsExtra(q.kind)) {
+            ASSERT_EQ(window.extra[i].exactMap.A, q.exactMap.A) << i;
+        }
+        if (needsExtra(q.kind)) {
+            ASSERT_EQ(window.extra[i].viewPos, q.viewPos) << i;
+        }
         ASSERT_EQ(window.members[i], batch.members[i]) << i;
         ASSERT_EQ(window.depth[i], batch.distance[i]) << i;
         const int64_t slab = std::clamp<int64_t>(int64_t(std::floor(batch.distance[i] / ctx.slabLength)), 3, 199);

@@ -81,7 +81,9 @@ TEST(Modes, EveryModeKeepsThePointsEnergy) {
                 const Primitive p = projectVoxel(c, sigma, glm::vec3(1.f), contextFor(cam, mode, h));
                 ASSERT_TRUE(p.kind == PrimitiveKind::Point || p.kind == PrimitiveKind::Splat)
                     << toString(mode) << " kind " << int(p.kind) << " spacing " << spacingPx << " θ " << thetaDeg;
-                if (drawsOnlySplats(mode)) EXPECT_EQ(p.kind, PrimitiveKind::Splat) << toString(mode);
+                if (drawsOnlySplats(mode)) {
+                    EXPECT_EQ(p.kind, PrimitiveKind::Splat) << toString(mode);
+                }
                 const double point = pointDepositTotal(sigma / h, h, cam.focal(), c);
                 EXPECT_NEAR(depositSum(p) / point, 1.0, 0.01)
                     << toString(mode) << " spacing " << spacingPx << " θ " << thetaDeg;
@@ -109,7 +111,9 @@ TEST(Modes, NonePointsLandOnOnePixelEach) {
         EXPECT_NEAR(depositAt(p, px, py), total, 1e-6 * total);
         for (int dy = -3; dy <= 3; ++dy)
             for (int dx = -3; dx <= 3; ++dx)
-                if (dx || dy) EXPECT_EQ(depositAt(p, px + dx, py + dy), 0.0) << dx << "," << dy;
+                if (dx || dy) {
+                    EXPECT_EQ(depositAt(p, px + dx, py + dy), 0.0) << dx << "," << dy;
+                }
     }
 }
 
