@@ -81,14 +81,20 @@ struct HugePageAllocator {
 };
 
 /// @brief Grows @p buffer to at least @p n elements without keeping its contents (a window's
-/// buffers are rewritten whole): no copy on growth, and 1/8 of headroom so that slowly growing
-/// windows do not reallocate every time (little: the window's buffers are the renderer's
-/// largest, DESIGN §5 bounds them by the window). Never shrinks.
+/// buffers are rewritten whole): no copy on growth. Never shrinks.
+///
+/// It grows to 4n: address space, not memory. The allocator constructs nothing (construct()
+/// above), so only the pages a window writes are faulted in, and a later window up to 4n reuses
+/// the pages the earlier ones faulted instead of faulting a fresh, larger block in again. Growing
+/// by exactly what was asked (or 1/8 more) re-faulted the whole prefix at every larger window: on
+/// the framed Engine at 400² the window buffers grew six times and faulted in 118 MB of huge
+/// pages for 26 MB of final buffers (docs/performance.md). What is resident stays bounded by the
+/// largest window (DESIGN §5).
 template <class Buffer>
 void growDiscarding(Buffer& buffer, std::size_t n) {
     if (buffer.size() >= n) return;
     Buffer().swap(buffer);
-    buffer.resize(n + n / 8);
+    buffer.resize(n > buffer.max_size() / 4 ? n : 4 * n);
 }
 
 }  // namespace vdbsplat

@@ -1,8 +1,10 @@
 // tests/util/test_huge_pages.cpp — the large-buffer allocator (util/huge_pages.h): blocks of
 // 2 MiB and more are huge-page aligned and usable to their last byte, small ones come from
-// operator new; elements are default-initialised; growDiscarding grows with headroom, never
-// shrinks, and does not copy.
+// operator new; elements are default-initialised; growDiscarding grows to 4n of address space
+// (not resident until written), never shrinks, and does not copy.
 #include <gtest/gtest.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include <cstdint>
 #include <numeric>
@@ -33,15 +35,39 @@ TEST(HugePages, SmallBlocksAndValuesAsGiven) {
 TEST(HugePages, GrowDiscardingNeverShrinksAndLeavesHeadroom) {
     std::vector<uint32_t, HugePageAllocator<uint32_t>> v;
     growDiscarding(v, 1000);
-    EXPECT_GE(v.size(), 1000u);
-    EXPECT_LT(v.size(), 2000u);
+    EXPECT_EQ(v.size(), 4000u);  // 4n: later, larger windows reuse the same block
     const size_t size = v.size();
     growDiscarding(v, 10);  // never shrinks
     EXPECT_EQ(v.size(), size);
+    growDiscarding(v, 4000);  // fits: the same block
+    EXPECT_EQ(v.size(), size);
     growDiscarding(v, 3u << 20);  // into huge pages
     EXPECT_GE(v.size(), 3u << 20);
+    v[0] = 5;
     v[v.size() - 1] = 7;
+    EXPECT_EQ(v.front(), 5u);
     EXPECT_EQ(v.back(), 7u);
+}
+
+// The headroom is address space: pages nobody wrote are not resident (growDiscarding constructs
+// nothing), so the window buffers' memory is what the largest window wrote.
+TEST(HugePages, GrowDiscardingHeadroomIsNotResident) {
+    std::vector<uint32_t, HugePageAllocator<uint32_t>> v;
+    growDiscarding(v, 4u << 20);  // 16 MB asked, 64 MB mapped
+    ASSERT_EQ(v.size(), 16u << 20);
+    for (size_t i = 0; i < (4u << 20); ++i) v[i] = uint32_t(i);
+    const size_t page = size_t(sysconf(_SC_PAGESIZE));
+    const auto resident = [&](size_t element) {
+        auto* at = reinterpret_cast<unsigned char*>(v.data() + element);
+        auto* start = reinterpret_cast<unsigned char*>(reinterpret_cast<uintptr_t>(at) / page * page);
+        unsigned char in = 0;
+        EXPECT_EQ(mincore(start, page, &in), 0);
+        return (in & 1) != 0;
+    };
+    EXPECT_TRUE(resident(0));
+    EXPECT_TRUE(resident((4u << 20) - 1));
+    EXPECT_FALSE(resident(v.size() - 1));       // 48 MB past what was written
+    EXPECT_FALSE(resident(v.size() / 2 + 17));  // 16 MB past it
 }
 
 }  // namespace
