@@ -61,16 +61,17 @@ PointFootprint rasterizePoint(const PointFilterTable& table, const PixelCoord& x
         dxs[ix] = static_cast<float>(out.x0 + ix + 0.5 - x.x);
         gx[ix] = table.weight(dxs[ix] * dxs[ix] * invV);
     }
-    float sum = 0.0f;
+    std::array<float, kPointSumColumns> columns{};
     for (int iy = 0; iy < out.ny; ++iy) {
         const float dy = static_cast<float>(out.y0 + iy + 0.5 - x.y), dy2 = dy * dy;
         gy[iy] = table.weight(dy2 * invV);
         for (int ix = 0; ix < out.nx; ++ix) {
             const float w = dxs[ix] * dxs[ix] + dy2 < rs2 ? gx[ix] * gy[iy] : 0.0f;
             out.w[iy * out.nx + ix] = w;
-            sum += w;
+            columns[size_t(ix)] += w;
         }
     }
+    const float sum = sumColumnsPairwise(columns.data());
     if (sum > 0.0f) {
         const float inv = 1.0f / sum;
         for (int k = 0; k < out.nx * out.ny; ++k) out.w[k] *= inv;
@@ -118,8 +119,8 @@ void finishPointSetup(PointSetup& s, const PixelCoord& x, float sum, float invV,
 }
 
 PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double variance) {
-    // rasterizePoint's footprint and its sum, in its order (row by row; a term outside the
-    // circle is +0 there and changes no sum), without storing the weights.
+    // rasterizePoint's footprint and its sum, in its order (sumColumnsPairwise; a term outside
+    // the circle is +0 there and changes no sum), without storing the weights.
     PointSetup s;
     float invV = 0.0f, rs2 = 0.0f;
     if (!pointSetupBox(x, variance, s, invV, rs2)) return s;
@@ -129,16 +130,16 @@ PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double
         dx2[size_t(ix)] = dx * dx;
         gx[size_t(ix)] = table.weight(dx * dx * invV);
     }
-    float sum = 0.0f;
+    std::array<float, kPointSumColumns> columns{};
     for (int iy = 0; iy < s.ny; ++iy) {
         const float dy = static_cast<float>(s.y0 + iy + 0.5 - x.y), dy2 = dy * dy;
         const float gy = table.weight(dy2 * invV);
         for (int ix = 0; ix < s.nx; ++ix) {  // branch-free: which pixels the circle keeps varies point by point
             const float w = gx[size_t(ix)] * gy;
-            sum += dx2[size_t(ix)] + dy2 < rs2 ? w : 0.0f;
+            columns[size_t(ix)] += dx2[size_t(ix)] + dy2 < rs2 ? w : 0.0f;
         }
     }
-    finishPointSetup(s, x, sum, invV, rs2);
+    finishPointSetup(s, x, sumColumnsPairwise(columns.data()), invV, rs2);
     return s;
 }
 

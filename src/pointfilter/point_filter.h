@@ -118,9 +118,19 @@ PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double
 
 /// @brief setupPoint's sum with Google Highway (pointfilter/point_setup.cpp, runtime dispatch):
 /// the weights of both axes in one vector (two gathers), the products and the circle row by row
-/// in vectors, then the sum in setupPoint's order. For a float centre (what the renderer stores)
+/// in vectors, each lane a column's sum (sumColumnsPairwise's order). For a float centre (what the renderer stores)
 /// the same PointSetup bit for bit (PointFilter.VectorSetupEqualsTheScalarSetup).
 PointSetup setupPointVector(const PointFilterTable& table, const PixelCoord& x, double variance);
+
+/// @brief The footprint's weights summed in the one order every setup uses: each column down
+/// its rows (@p columns[ix] = Σ over iy in order, a weight outside the circle or a column past
+/// nx adding +0), then the eight columns pairwise. A vector accumulates the columns in its lanes
+/// with no dependency between them, where a row-by-row sum was 49 dependent additions.
+inline float sumColumnsPairwise(const float* columns) {
+    return ((columns[0] + columns[1]) + (columns[2] + columns[3])) + ((columns[4] + columns[5]) + (columns[6] + columns[7]));
+}
+inline constexpr int kPointSumColumns = 8;  ///< ≥ kPointMaxSide: the columns sumColumnsPairwise adds
+static_assert(kPointMaxSide <= kPointSumColumns);
 
 /// setupPoint's parts before and after the sum (shared by the scalar and the vector setup):
 /// the footprint's box, 1/V and r_s² (false: nothing to draw); then norm, or the one-pixel fallback.

@@ -37,23 +37,23 @@ PointSetup SetupPoint(const PointFilterTable& table, const PixelCoord& x, double
         hn::Store(off2, d, sq + k);
         hn::Store(PointWeight(d, table, hn::Mul(off2, hn::Set(d, invV))), d, g + k);
     }
-    // Each row's terms (0 outside the circle and past nx), in one vector of 8, then the sum in
-    // setupPoint's order: adding +0 changes no sum.
-    const hn::CappedTag<float, 8> d8;
+    // Each column's sum down the rows in a lane (0 outside the circle and past nx; adding +0
+    // changes no sum), then the columns pairwise: sumColumnsPairwise's order, as setupPoint's.
+    const hn::CappedTag<float, kPointSumColumns> d8;
     constexpr int N8 = int(hn::MaxLanes(d8));
-    alignas(64) float terms[kPointMaxSide * 8];
-    for (int k = 0; k < 8; k += N8) {
+    alignas(64) float columns[kPointSumColumns];
+    for (int k = 0; k < kPointSumColumns; k += N8) {
         const auto gx = hn::Load(d8, g + k), dx2 = hn::Load(d8, sq + k);
         const auto cols = hn::RebindMask(d8, hn::Lt(hn::Iota(hn::RebindToSigned<decltype(d8)>(), k),
                                                     hn::Set(hn::RebindToSigned<decltype(d8)>(), s.nx)));
+        auto acc = hn::Zero(d8);
         for (int iy = 0; iy < s.ny; ++iy) {
             const auto in = hn::And(cols, hn::Lt(hn::Add(dx2, hn::Set(d8, sq[8 + iy])), hn::Set(d8, rs2)));
-            hn::Store(hn::IfThenElseZero(in, hn::Mul(gx, hn::Set(d8, g[8 + iy]))), d8, terms + iy * 8 + k);
+            acc = hn::Add(acc, hn::IfThenElseZero(in, hn::Mul(gx, hn::Set(d8, g[8 + iy]))));
         }
+        hn::Store(acc, d8, columns + k);
     }
-    float sum = 0.0f;
-    for (int iy = 0; iy < s.ny; ++iy)
-        for (int ix = 0; ix < s.nx; ++ix) sum += terms[iy * 8 + ix];
+    const float sum = sumColumnsPairwise(columns);
     finishPointSetup(s, x, sum, invV, rs2);
     return s;
 }

@@ -630,8 +630,12 @@ TEST(Forward, CroppingToTheVolumeKeepsTheImage) {
         EXPECT_GT(sum, 1.0) << view.name;  // the volume is in the picture
         EXPECT_LT(worst, 1e-5) << view.name << " " << toString(view.s.mode) << " " << toString(view.s.filterOrder);
         const std::string name = view.name;
-        if (name == "far") EXPECT_LT(cropped.compositedPixels * 4, whole.compositedPixels);
-        if (name == "side") EXPECT_LT(cropped.compositedPixels, whole.compositedPixels);
+        if (name == "far") {
+            EXPECT_LT(cropped.compositedPixels * 4, whole.compositedPixels);
+        }
+        if (name == "side") {
+            EXPECT_LT(cropped.compositedPixels, whole.compositedPixels);
+        }
     }
 }
 

@@ -333,8 +333,9 @@ TEST(Stream, BlendedLevelsKeepTheEnergy) {
         // blending costs at most the switching rule's records plus its lighter level's (an eighth
         // on this dense grid; a rule whose 2³ → 4³ passage ran past ℓ = 2 drew 9× there).
         const Drawn before = draw(distance * std::exp2(-(kLodPassage[0].second - kLodPassage[0].first)), false);
-        if (before.records * 4 <= voxelCount)
+        if (before.records * 4 <= voxelCount) {
             EXPECT_LE(double(d.records), 1.25 * double(lo.records)) << "distance " << distance;
+        }
         std::printf("  distance %.3f: %llu records (switching: %llu, and %llu at twice the distance)\n", distance,
                     (unsigned long long)d.records, (unsigned long long)lo.records, (unsigned long long)hi.records);
     }
