@@ -32,11 +32,10 @@ inline bool rowChord(const SplatRaster& s, float dy, int& xa, int& xb) {
     return xa <= xb;
 }
 
-/// T·α of the splat at pixel offsets (dx, dy) from its centre, for the lanes of @p mask (which
-/// the exact index narrows to d² < 1): τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h),
-/// α = 1 − e^{−τ}.
+/// τ of the splat at pixel offsets (dx, dy) from its centre, for the lanes of @p mask (which
+/// the exact index narrows to d² < 1): τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h).
 template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
-HWY_INLINE V OpacityTimesT(D d, const SplatRaster& s, V dx, V dy, V i2, V T, M& mask) {
+HWY_INLINE V Tau(D d, const SplatRaster& s, V dx, V dy, V i2, M& mask) {
     const V zero = hn::Zero(d), one = hn::Set(d, 1.f), two = hn::Set(d, 2.f);
     V t;
     if (s.exactIndex) {  // d² = |w|² / |v|² / r², w = c × v (DESIGN §3; ExactIndexMap::d2)
@@ -59,9 +58,32 @@ HWY_INLINE V OpacityTimesT(D d, const SplatRaster& s, V dx, V dy, V i2, V T, M& 
     V p = hn::Set(d, s.coef[FootprintPolynomials::kDegree]);
 #pragma GCC unroll 16
     for (int j = FootprintPolynomials::kDegree - 1; j >= 0; --j) p = hn::MulAdd(p, x, hn::Set(d, s.coef[size_t(j)]));
-    const V tau = hn::Max(hn::Mul(hn::Mul(hn::Set(d, s.scale), hn::Sqrt(hn::Sub(one, t))), p), zero);
+    return hn::Max(hn::Mul(hn::Mul(hn::Set(d, s.scale), hn::Sqrt(hn::Sub(one, t))), p), zero);
+}
+
+/// T·α of the splat (Tau), α = 1 − e^{−τ}.
+template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
+HWY_INLINE V OpacityTimesT(D d, const SplatRaster& s, V dx, V dy, V i2, V T, M& mask) {
+    const V tau = Tau(d, s, dx, dy, i2, mask);
     const V alpha = hn::Neg(hn::Expm1(d, hn::Neg(tau)));  // 1 − e^{−τ}
     return hn::Mul(T, alpha);
+}
+
+/// --compositing slabs: τ·fraction_j and τ·fraction_j·c added to slab j's sums at the lanes of
+/// @p mask; @p load and @p store read and write one vector of a tile array at the lanes' pixels.
+template <class D, class V, class M, class Load, class Store>
+HWY_INLINE void DepositSlabs(D d, const SplatRaster& s, V tau, M mask, const Load& load, const Store& store) {
+    const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
+    const SlabTargets& slabs = *s.slabs;
+    for (int j = 0; j < slabs.count; ++j) {
+        const V tj = hn::Mul(tau, hn::Set(d, slabs.fraction[size_t(j)]));
+        const V t0 = load(slabs.tau[size_t(j)]), r0 = load(slabs.er[size_t(j)]), g0 = load(slabs.eg[size_t(j)]),
+                b0 = load(slabs.eb[size_t(j)]);
+        store(slabs.tau[size_t(j)], hn::IfThenElse(mask, hn::Add(t0, tj), t0));
+        store(slabs.er[size_t(j)], hn::IfThenElse(mask, hn::MulAdd(tj, cr, r0), r0));
+        store(slabs.eg[size_t(j)], hn::IfThenElse(mask, hn::MulAdd(tj, cg, g0), g0));
+        store(slabs.eb[size_t(j)], hn::IfThenElse(mask, hn::MulAdd(tj, cb, b0), b0));
+    }
 }
 
 /// i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²
@@ -94,6 +116,12 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
             const V T = hn::Load(d, pt);
             auto mask = hn::And(hn::And(hn::Ge(xPix, lo), hn::Lt(xPix, hi)), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
             if (hn::AllFalse(d, mask)) continue;
+            if (s.slabs) {
+                const V tau = Tau(d, s, dx, dy, i2, mask);
+                DepositSlabs(d, s, tau, mask, [&](float* base) { return hn::Load(d, base + row + c); },
+                             [&](float* base, V v) { hn::Store(v, d, base + row + c); });
+                continue;
+            }
             const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
             float *pr = tile.R + row + c, *pg = tile.G + row + c, *pb = tile.B + row + c;
             hn::Store(hn::IfThenElse(mask, hn::MulAdd(ta, cr, hn::Load(d, pr)), hn::Load(d, pr)), d, pr);
@@ -135,11 +163,15 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const int*
         auto mask = hn::And(hn::And(hn::Ge(xPix, lo), hn::Lt(xPix, hi)), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
         if (!pair) mask = hn::And(mask, hn::FirstN(d, kHalf));
         if (hn::AllFalse(d, mask)) continue;
-        const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
         const auto store = [&](float* base, V value) {
             hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
             if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
+        if (s.slabs) {
+            DepositSlabs(d, s, Tau(d, s, dx, dy, i2, mask), mask, [&](float* base) { return load(base); }, store);
+            continue;
+        }
+        const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
         const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
         store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, cr, R), R));
         store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, cg, G), G));
@@ -218,6 +250,17 @@ void drawSplatScalarPoly(const SplatRaster& s, const TileBuffers& tile) {
             if (!(i2 < 1.f)) continue;
             const float t = s.exactIndex ? s.map.d2(dx, dy) : i2;
             const float tau = s.scale * FootprintPolynomials::evaluate(s.coef, t);
+            if (s.slabs) {
+                if (s.exactIndex && !(t < 1.f)) continue;  // as the vector loop's mask
+                for (int j = 0; j < s.slabs->count; ++j) {
+                    const float tj = tau * s.slabs->fraction[size_t(j)];
+                    s.slabs->tau[size_t(j)][i] += tj;
+                    s.slabs->er[size_t(j)][i] += tj * s.color.x;
+                    s.slabs->eg[size_t(j)][i] += tj * s.color.y;
+                    s.slabs->eb[size_t(j)][i] += tj * s.color.z;
+                }
+                continue;
+            }
             const float alpha = opacityFromOpticalDepth(tau);
             const float ta = tile.T[i] * alpha;
             tile.R[i] += ta * s.color.x;

@@ -46,13 +46,21 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     shape.sphere = volume.isotropic;
     ExactContext exact{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance};
     exact.shape = &shape;
-    TileCompositor compositor(camera.width(), camera.height(), tables, exact);
+    // --compositing slabs: a kernel reaches R·(its longest semi-axis per index unit) along any
+    // ray, so K = ⌈R·sMax / slab length⌉ slabs on either side of its own (2 for cubic voxels).
+    SlabCompositing slabs;
+    if (settings.compositing == CompositingOrder::Slabs) {
+        slabs.on = true;
+        slabs.reach = slabReachFor(tables.kernel->radius() * shape.sMax / stream.slabLength());
+    }
+    TileCompositor compositor(camera.width(), camera.height(), tables, exact, slabs);
     ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
                           settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
                           pass.prefilterVariance};
     ctx.shape = &shape;
     ctx.occlusion = &compositor;
     ctx.vector = settings.simd;
+    ctx.slabs = slabs;
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
     ProjectedWindow window;
@@ -87,6 +95,9 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     stats.windows = stream.windows();
     stats.largestWindow = stream.largestWindow();
     stats.compositedPixels = uint64_t(camera.width()) * uint64_t(camera.height());
+    auto t = Clock::now();
+    compositor.finish();
+    stats.compositeSeconds += since(t);
     return compositor.image();
 }
 
