@@ -83,6 +83,10 @@ constexpr RenderFlag kRenderFlags[] = {
      "spread over the depth slabs it spans along the ray, each slab\n"
      "composited once (closer to the reference where colour changes from\n"
      "voxel to voxel, e.g. --shading; docs/compositing.md)"},
+    {"--slab-thickness", "V", kQuality,
+     "depth slab thickness in voxels, 0.5..1 (default: 1 with --compositing\n"
+     "kernels, 0.5 with slabs): points are summed per slab, and --compositing\n"
+     "slabs composites once per slab"},
     {"--simd", "on|off", kQuality, "splats through the vector loop (default on) or the scalar table path"},
     {"--show-primitives", nullptr, kQuality, "tint splats red, points keep their colour"},
     {"--tables", "DIR", kQuality,
@@ -213,6 +217,7 @@ RenderSettings settingsFromFlags(const Args& args) {
         s.lodBlend = *v == "on";
     }
     if (auto v = args.get("--compositing")) s.compositing = parseCompositingOrder(*v);
+    if (auto v = args.get("--slab-thickness")) s.slabThickness = parseDouble(*v, "--slab-thickness");
     if (auto v = args.get("--simd")) {
         if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
         s.simd = *v == "on";

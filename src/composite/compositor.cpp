@@ -95,7 +95,10 @@ struct TileCompositor::SlabRing {
     std::vector<SlabBuffer> slot;
     explicit SlabRing(int reach) : slot(size_t(2 * reach + 1)) {}
     bool open() const { return last >= first; }
-    SlabBuffer& at(int64_t slab) { return slot[size_t(slab % int64_t(slot.size()))]; }
+    SlabBuffer& at(int64_t slab) {  // slabs before the eye (first < 0 near it) hold nothing, but are walked
+        const int64_t n = int64_t(slot.size()), r = slab % n;
+        return slot[size_t(r < 0 ? r + n : r)];
+    }
 };
 
 TileCompositor::TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs)
@@ -343,16 +346,18 @@ void TileCompositor::storeTile(int tile, const TilePixels& px) {
 
 namespace {
 /// One "over" per pixel with the slab's summed optical depth and colour Σ τc / Σ τ, then the
-/// slab is emptied (DESIGN §4).
+/// slab is emptied (DESIGN §4). @p skipFinished: pixels already finished (T < ε) take nothing
+/// (the slab order, whose slabs are composited after later primitives were deposited; in the
+/// kernel order a slab's pixels were all live when it was filled and still are).
 template <class Pixels, class Slab>
-void compositeSlab(Pixels& px, Slab& slab) {
+void compositeSlab(Pixels& px, Slab& slab, bool skipFinished = false) {
     if (!slab.dirty) return;
     for (int y = px.y0; y <= px.y1; ++y)
         for (int x = px.x0; x <= px.x1; ++x) {
             const int i = px.local(x, y);
             const size_t j = size_t(i);
             const float tau = slab.tau[j];
-            if (tau > 0.f) px.over(i, tau, glm::vec3(slab.er[j], slab.eg[j], slab.eb[j]) / tau);
+            if (tau > 0.f && (!skipFinished || px.live(i))) px.over(i, tau, glm::vec3(slab.er[j], slab.eg[j], slab.eb[j]) / tau);
             slab.tau[j] = 0.f, slab.er[j] = 0.f, slab.eg[j] = 0.f, slab.eb[j] = 0.f;
         }
     slab.dirty = false;
@@ -415,7 +420,7 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entr
     const auto closeUpTo = [&](int64_t end) {  // composites the open slabs before `end`
         if (ring.first >= end) return;
         if (ring.open())
-            for (int64_t s = ring.first; s < end && s <= ring.last; ++s) compositeSlab(px, ring.at(s));
+            for (int64_t s = ring.first; s < end && s <= ring.last; ++s) compositeSlab(px, ring.at(s), true);
         ring.first = end;
     };
     const int64_t base = window_->slabBase;
@@ -464,7 +469,7 @@ void TileCompositor::finish() {
             if (ring->open()) {
                 TilePixels px;
                 loadTile(tile, px);
-                for (int64_t s = ring->first; s <= ring->last; ++s) compositeSlab(px, ring->at(s));
+                for (int64_t s = ring->first; s <= ring->last; ++s) compositeSlab(px, ring->at(s), true);
                 storeTile(tile, px);
             }
             ring.reset();

@@ -24,7 +24,7 @@
 namespace vdbsplat {
 
 /// The most slabs a primitive reaches on either side of its own (a window of 2K + 1 slabs).
-inline constexpr int kMaxSlabReach = 4;
+inline constexpr int kMaxSlabReach = 8;
 inline constexpr int kMaxSlabSpan = 2 * kMaxSlabReach + 1;
 
 /// @brief The fractions of a primitive's optical depth for the slabs s − K + j, j = 0 … 2K

@@ -32,6 +32,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
                 const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
                 const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
     StreamOptions streamOptions = settings.stream;
+    streamOptions.slabThickness = settings.effectiveSlabThickness();
     streamOptions.lodCellPx = pass.lodPx;
     streamOptions.lodBlend = settings.lodBlend;
     streamOptions.pointPrefilterVariance = pass.prefilterVariance;

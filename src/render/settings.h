@@ -109,6 +109,12 @@ struct RenderSettings {
     /// kernel's optical depth spread over the radial slabs it spans and each slab composited
     /// once (Slabs; composite/compositing.h, docs/compositing.md). The reference ignores it.
     CompositingOrder compositing = CompositingOrder::Kernels;
+    /// Depth slab thickness in voxels (--slab-thickness, [0.5, 1]); 0: automatic, 1 in the kernel
+    /// order and ½ in the slab order (docs/compositing.md: half-voxel slabs gain 2–17 dB there).
+    double slabThickness = 0.0;
+    double effectiveSlabThickness() const {
+        return slabThickness > 0.0 ? slabThickness : compositing == CompositingOrder::Slabs ? 0.5 : 1.0;
+    }
     /// Splats through the vector loop (Highway, polynomial footprint); false: the scalar table
     /// path it is tested against (same image to ~1e−6; for measuring).
     bool simd = true;
