@@ -420,13 +420,17 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entr
     const auto closeUpTo = [&](int64_t end) {  // composites the open slabs before `end`
         if (ring.first >= end) return;
         if (ring.open())
-            for (int64_t s = ring.first; s < end && s <= ring.last; ++s) compositeSlab(px, ring.at(s), true);
+            for (int64_t s = ring.first; s < end && s <= ring.last; ++s) closeSlab(px, ring.at(s));
         ring.first = end;
     };
     const int64_t base = window_->slabBase;
     constexpr size_t kAhead = 8, kMapAhead = 4;
     for (size_t e = 0; e < entries.size(); ++e) {
-        if (e + kAhead < entries.size()) __builtin_prefetch(&records_[entries[e + kAhead]]);
+        if (e + kAhead < entries.size()) {  // the record and its profile (two lines)
+            __builtin_prefetch(&records_[entries[e + kAhead]]);
+            const char* profile = reinterpret_cast<const char*>(&profiles_[entries[e + kAhead]]);
+            __builtin_prefetch(profile), __builtin_prefetch(profile + sizeof(SlabProfile) - 1);
+        }
         if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) {
             const char* map = reinterpret_cast<const char*>(&maps_[entries[e + kMapAhead]]);
             __builtin_prefetch(map), __builtin_prefetch(map + sizeof(ExactIndexMap) - 1);
@@ -456,8 +460,19 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entr
     }
     closeUpTo(closeBefore);
     if (px.countLive() == 0 && ring.open()) closeUpTo(ring.last + 1);
-    if (!ring.open()) owned.reset();
+    // The ring stays with its tile until finish(): its slots are empty again once composited, and
+    // allocating (zeroing) 2K + 1 slabs anew for every window cost more than the tile's work.
     storeTile(tile, px);
+}
+
+void TileCompositor::closeSlab(TilePixels& px, SlabBuffer& slab) const {
+    if (!slab.dirty) return;
+    if (!exact_.vector) {
+        compositeSlab(px, slab, true);
+        return;
+    }
+    compositeSlabVector(slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.buffers(), kTransmittanceEpsilon);
+    slab.dirty = false;
 }
 
 void TileCompositor::finish() {
@@ -469,7 +484,7 @@ void TileCompositor::finish() {
             if (ring->open()) {
                 TilePixels px;
                 loadTile(tile, px);
-                for (int64_t s = ring->first; s <= ring->last; ++s) compositeSlab(px, ring->at(s), true);
+                for (int64_t s = ring->first; s <= ring->last; ++s) closeSlab(px, ring->at(s));
                 storeTile(tile, px);
             }
             ring.reset();

@@ -104,6 +104,7 @@ private:
     void storeTile(int tile, const TilePixels& px);
     void compositeTile(int tile, std::span<const uint32_t> entries);
     void compositeTileSlabs(int tile, std::span<const uint32_t> entries, int64_t closeBefore);
+    void closeSlab(TilePixels& px, SlabBuffer& slab) const;  // one "over" per live pixel, then empty
     void drawPrimitive(const TileRecord& p, uint32_t k, TilePixels& px, SlabBuffer* slab, const SlabTargets* slabs) const;
     void drawPoint(const TileRecord& p, const TilePixels& tile, SlabBuffer* slab, const SlabTargets* slabs) const;
     void drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile, const SlabTargets* slabs) const;

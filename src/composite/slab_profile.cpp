@@ -22,18 +22,26 @@ double kernelMarginalCdf(const KernelShape& kernel, double x) {
     return std::clamp(kernel.normalization() * twoPi * s * s * (gauss - floorTerm), 0.0, 1.0);
 }
 
-SlabProfile slabFractions(const KernelShape& kernel, double offset, double unitInSlabs, int reach, int lowest) {
+MarginalCdfTable::MarginalCdfTable(const KernelShape& kernel)
+    : radius_(kernel.radius()), scale_(double(kIntervals) / (2.0 * kernel.radius())) {
+    for (int i = 0; i <= kIntervals; ++i) value_[size_t(i)] = kernelMarginalCdf(kernel, -radius_ + double(i) / scale_);
+}
+
+template <class Cdf>
+SlabProfile slabFractionsOf(const Cdf& cdf, double offset, double unitInSlabs, int reach, int lowest) {
     SlabProfile p;
     reach = std::clamp(reach, 0, kMaxSlabReach);
     const double inv = 1.0 / std::max(unitInSlabs, 1e-12);
     double sum = 0.0;
     std::array<double, kMaxSlabSpan> f{};
-    for (int r = std::max(-reach, lowest); r <= reach; ++r) {
-        // slab s + r covers [r, r + 1) slab lengths from the start of slab s; the kernel centre is at `offset`
-        const double lo = kernelMarginalCdf(kernel, (double(r) - offset) * inv);
-        const double hi = kernelMarginalCdf(kernel, (double(r) + 1.0 - offset) * inv);
+    // slab s + r covers [r, r + 1) slab lengths from the start of slab s; the kernel centre is at `offset`
+    const int first = std::max(-reach, lowest);
+    double lo = cdf((double(first) - offset) * inv);
+    for (int r = first; r <= reach; ++r) {
+        const double hi = cdf((double(r) + 1.0 - offset) * inv);
         f[size_t(r + reach)] = std::max(hi - lo, 0.0);
         sum += f[size_t(r + reach)];
+        lo = hi;
     }
     if (!(sum > 0.0)) {  // nothing within reach (a centre far outside its slab): all in its own slab
         p.fraction[size_t(reach)] = 1.f;
@@ -41,6 +49,14 @@ SlabProfile slabFractions(const KernelShape& kernel, double offset, double unitI
     }
     for (int j = 0; j <= 2 * reach; ++j) p.fraction[size_t(j)] = float(f[size_t(j)] / sum);
     return p;
+}
+
+SlabProfile slabFractions(const KernelShape& kernel, double offset, double unitInSlabs, int reach, int lowest) {
+    return slabFractionsOf([&](double x) { return kernelMarginalCdf(kernel, x); }, offset, unitInSlabs, reach, lowest);
+}
+
+SlabProfile slabFractions(const MarginalCdfTable& cdf, double offset, double unitInSlabs, int reach, int lowest) {
+    return slabFractionsOf(cdf, offset, unitInSlabs, reach, lowest);
 }
 
 int slabReachFor(double radiusInSlabs) {

@@ -227,6 +227,28 @@ void DrawSplatRowsFor(D d, const SplatRaster& s, const TileBuffers& tile) {
 
 void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) { DrawSplatRowsFor(hn::CappedTag<float, kStride>(), s, tile); }
 
+/// One slab over the tile's live pixels, then emptied (compositeSlabVector).
+void CompositeSlab(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon) {
+    const hn::CappedTag<float, kStride> d;
+    using V = hn::Vec<decltype(d)>;
+    const int n = int(hn::Lanes(d));
+    const V zero = hn::Zero(d), eps = hn::Set(d, epsilon);
+    for (int i = 0; i < kStride * kStride; i += n) {
+        const V t = hn::Load(d, tau + i);
+        const V T = hn::Load(d, tile.T + i);
+        const auto mask = hn::And(hn::Gt(t, zero), hn::Ge(T, eps));
+        if (!hn::AllFalse(d, mask)) {
+            const V ta = hn::Mul(T, hn::Neg(hn::Expm1(d, hn::Neg(t))));  // T·α
+            const V w = hn::IfThenElseZero(mask, hn::Div(ta, hn::IfThenElse(mask, t, hn::Set(d, 1.f))));
+            hn::Store(hn::MulAdd(w, hn::Load(d, er + i), hn::Load(d, tile.R + i)), d, tile.R + i);
+            hn::Store(hn::MulAdd(w, hn::Load(d, eg + i), hn::Load(d, tile.G + i)), d, tile.G + i);
+            hn::Store(hn::MulAdd(w, hn::Load(d, eb + i), hn::Load(d, tile.B + i)), d, tile.B + i);
+            hn::Store(hn::IfThenElse(mask, hn::Sub(T, ta), T), d, tile.T + i);
+        }
+        hn::Store(zero, d, tau + i), hn::Store(zero, d, er + i), hn::Store(zero, d, eg + i), hn::Store(zero, d, eb + i);
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace vdbsplat
 HWY_AFTER_NAMESPACE();
@@ -235,6 +257,11 @@ HWY_AFTER_NAMESPACE();
 namespace vdbsplat {
 
 HWY_EXPORT(DrawSplatRows);
+HWY_EXPORT(CompositeSlab);
+
+void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon) {
+    HWY_DYNAMIC_DISPATCH(CompositeSlab)(tau, er, eg, eb, tile, epsilon);
+}
 
 void drawSplatVector(const SplatRaster& s, const TileBuffers& tile) { HWY_DYNAMIC_DISPATCH(DrawSplatRows)(s, tile); }
 

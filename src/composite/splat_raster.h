@@ -49,6 +49,11 @@ struct SplatRaster {
 /// @brief Composites @p s "over" the pixels of @p tile (front to back).
 void drawSplatVector(const SplatRaster& s, const TileBuffers& tile);
 
+/// @brief --compositing slabs: composites one slab of a tile (optical depth @p tau and σ-weighted
+/// emission @p er, @p eg, @p eb, 256 pixels each) onto @p tile's live pixels (T ≥ @p epsilon):
+/// α = 1 − e^{−τ}, C += T·α·e/τ, T *= 1 − α; then empties the slab. Vectorised (Highway).
+void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon);
+
 /// @brief The same loop one pixel at a time, in the same float operations (tests: the vector
 /// loop must agree with it to float rounding).
 void drawSplatScalarPoly(const SplatRaster& s, const TileBuffers& tile);

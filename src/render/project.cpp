@@ -172,7 +172,9 @@ SlabProfile slabProfileFor(const glm::dvec3& c, double distance, int64_t slab, f
     const double s = kernel.sigma();
     const double unit = std::sqrt(unit0 * unit0 + double(depthSpread) / (s * s));
     const double offset = distance / ctx.slabLength - double(slab);
-    return slabFractions(kernel, offset, unit / ctx.slabLength, ctx.slabs.reach, int(-std::min<int64_t>(slab, kMaxSlabReach)));
+    const int lowest = int(-std::min<int64_t>(slab, kMaxSlabReach));
+    return ctx.marginal ? slabFractions(*ctx.marginal, offset, unit / ctx.slabLength, ctx.slabs.reach, lowest)
+                        : slabFractions(kernel, offset, unit / ctx.slabLength, ctx.slabs.reach, lowest);
 }
 
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window) {

@@ -49,8 +49,10 @@ struct ProjectionContext {
     /// scalar oracle (--simd off). The same values either way.
     bool vector = true;
     /// --compositing slabs: each drawn primitive gets the fractions of its optical depth for the
-    /// slabs around its own (composite/slab_profile.h; `reach` as the compositor's).
+    /// slabs around its own (composite/slab_profile.h; `reach` as the compositor's), from the
+    /// kernel's tabulated marginal `marginal` (required when slabs.on).
     SlabCompositing slabs = {};
+    const MarginalCdfTable* marginal = nullptr;
 };
 
 /// What one window's primitives draw, before the compositor's occlusion culling (integer sums:

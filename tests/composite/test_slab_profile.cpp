@@ -115,6 +115,24 @@ TEST(SlabProfile, PerRayProfileDiffersLittleFromTheFootprintsOwn) {
     }
 }
 
+// The projection's tabulated C(x) against the closed form, and the fractions it gives.
+TEST(SlabProfile, TabulatedMarginalMatchesTheClosedForm) {
+    for (const KernelShape* k : {&KernelShape::standard(), &KernelShape::sharp()}) {
+        const MarginalCdfTable table(*k);
+        double worst = 0.0;
+        for (int i = 0; i <= 100000; ++i) {
+            const double x = -2.5 + 5.0 * i / 100000;
+            worst = std::max(worst, std::abs(table(x) - kernelMarginalCdf(*k, x)));
+        }
+        std::printf("  %s: tabulated C(x) max error %.2e\n", k->id(), worst);
+        EXPECT_LT(worst, 1e-7) << k->id();
+        for (const double offset : {0.0, 0.3, 0.99}) {
+            const SlabProfile a = slabFractions(*k, offset, 2.0, 4), b = slabFractions(table, offset, 2.0, 4);
+            for (int j = 0; j < kMaxSlabSpan; ++j) EXPECT_NEAR(a.fraction[size_t(j)], b.fraction[size_t(j)], 3e-7);
+        }
+    }
+}
+
 // The energy rule (DESIGN §4): every primitive's fractions sum to 1 in float, whatever its
 // centre, its width (aggregates whose profile reaches past K slabs are truncated and renormalised),
 // or a cut at the eye.
