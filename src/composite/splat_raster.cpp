@@ -75,14 +75,15 @@ template <class D, class V, class M, class Load, class Store>
 HWY_INLINE void DepositSlabs(D d, const SplatRaster& s, V tau, M mask, const Load& load, const Store& store) {
     const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
     const SlabTargets& slabs = *s.slabs;
+    // Lanes outside the mask add 0 (exactly: x + 0 = x, and 0·c + x = x for finite c).
+    const V tauIn = hn::IfThenElseZero(mask, tau);
     for (int j = 0; j < slabs.count; ++j) {
-        const V tj = hn::Mul(tau, hn::Set(d, slabs.fraction[size_t(j)]));
-        const V t0 = load(slabs.tau[size_t(j)]), r0 = load(slabs.er[size_t(j)]), g0 = load(slabs.eg[size_t(j)]),
-                b0 = load(slabs.eb[size_t(j)]);
-        store(slabs.tau[size_t(j)], hn::IfThenElse(mask, hn::Add(t0, tj), t0));
-        store(slabs.er[size_t(j)], hn::IfThenElse(mask, hn::MulAdd(tj, cr, r0), r0));
-        store(slabs.eg[size_t(j)], hn::IfThenElse(mask, hn::MulAdd(tj, cg, g0), g0));
-        store(slabs.eb[size_t(j)], hn::IfThenElse(mask, hn::MulAdd(tj, cb, b0), b0));
+        const V tj = hn::Mul(tauIn, hn::Set(d, slabs.fraction[size_t(j)]));
+        float *pt = slabs.tau[size_t(j)], *pr = slabs.er[size_t(j)], *pg = slabs.eg[size_t(j)], *pb = slabs.eb[size_t(j)];
+        store(pt, hn::Add(load(pt), tj));
+        store(pr, hn::MulAdd(tj, cr, load(pr)));
+        store(pg, hn::MulAdd(tj, cg, load(pg)));
+        store(pb, hn::MulAdd(tj, cb, load(pb)));
     }
 }
 
