@@ -171,6 +171,31 @@ TEST(SlabCompositing, ImagesDoNotDependOnThreadCountOrWindowSize) {
     }
 }
 
+// Every forward mode draws through the slab order (the study modes' kernels included): bit for bit
+// the same with 1 and 2 threads, and no further from the reference than the kernel order.
+TEST(SlabCompositing, EveryForwardModeTakesIt) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    const Image reference = renderWith(marschnerLobb(), tf, settingsFor(RenderMode::Reference, 1.0));
+    for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Point, RenderMode::Splat, RenderMode::Ewa,
+                                  RenderMode::Swan, RenderMode::None}) {
+        const RenderSettings s = settingsFor(mode, 1.0);
+        const double kernels = compareImages(renderWith(marschnerLobb(), tf, s), reference).psnr;
+        Image one, two;
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+            one = renderWith(marschnerLobb(), tf, withOrder(s, CompositingOrder::Slabs));
+        }
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+            two = renderWith(marschnerLobb(), tf, withOrder(s, CompositingOrder::Slabs));
+        }
+        EXPECT_EQ(one.pixels, two.pixels) << toString(mode);
+        const double slabs = compareImages(one, reference).psnr;
+        std::printf("  %-6s against the reference: kernels %.2f dB, slabs %.2f dB\n", toString(mode).c_str(), kernels, slabs);
+        EXPECT_GT(slabs, kernels - 0.5) << toString(mode);
+    }
+}
+
 // The scalar table path (--simd off) is the oracle of the vector loops in the slab order too.
 TEST(SlabCompositing, VectorLoopsMatchTheScalarPaths) {
     const TransferFunction tf = TransferFunction::preset("grey");
