@@ -459,10 +459,13 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entr
         if (targets.count > 0) drawPrimitive(p, k, px, nullptr, &targets);
     }
     closeUpTo(closeBefore);
-    if (px.countLive() == 0 && ring.open()) closeUpTo(ring.last + 1);
-    // The ring stays with its tile until finish(): its slots are empty again once composited, and
-    // allocating (zeroing) 2K + 1 slabs anew for every window cost more than the tile's work.
+    const bool opaque = px.countLive() == 0;
+    if (opaque && ring.open()) closeUpTo(ring.last + 1);
+    // The ring stays with its tile until finish() (its slots are empty again once composited, and
+    // allocating, zeroing, 2K + 1 slabs anew for every window cost more than the tile's work),
+    // unless the tile is opaque: no primitive reaches it any more (binning skips it).
     storeTile(tile, px);
+    if (opaque) owned.reset();
 }
 
 void TileCompositor::closeSlab(TilePixels& px, SlabBuffer& slab) const {
