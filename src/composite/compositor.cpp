@@ -99,6 +99,24 @@ struct TileCompositor::SlabRing {
         const int64_t n = int64_t(slot.size()), r = slab % n;
         return slot[size_t(r < 0 ? r + n : r)];
     }
+    /// The slabs a primitive of slab @p slab with @p profile deposits into (those of non-zero
+    /// fraction), marked dirty and open.
+    SlabTargets targets(const SlabProfile& profile, int64_t slab, int reach) {
+        SlabTargets t;
+        for (int j = 0; j <= 2 * reach; ++j) {
+            const float f = profile.fraction[size_t(j)];
+            if (!(f > 0.f)) continue;
+            // Never before the first open slab (only a primitive out of slab order could ask for it).
+            const int64_t to = std::max(slab - reach + j, first);
+            SlabBuffer& b = at(to);
+            b.dirty = true;
+            last = open() ? std::max(last, to) : to;
+            const size_t n = size_t(t.count++);
+            t.tau[n] = b.tau.data(), t.er[n] = b.er.data(), t.eg[n] = b.eg.data(), t.eb[n] = b.eb.data();
+            t.fraction[n] = f;
+        }
+        return t;
+    }
 };
 
 TileCompositor::TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs)
@@ -378,20 +396,29 @@ void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t k, TilePixels& 
     }
 }
 
+/// Records are a cache miss each (a tile's list is sparse in records_): fetch them (and, in the
+/// slab order, their profiles) 8 ahead, and an exact-index splat's map (two lines) 4 ahead, once
+/// its record has arrived.
+void TileCompositor::prefetchAhead(std::span<const uint32_t> entries, size_t e, bool profiles) const {
+    constexpr size_t kAhead = 8, kMapAhead = 4;
+    const auto lines = [](const auto* p) {
+        const char* c = reinterpret_cast<const char*>(p);
+        __builtin_prefetch(c), __builtin_prefetch(c + sizeof(*p) - 1);
+    };
+    if (e + kAhead < entries.size()) {
+        __builtin_prefetch(&records_[entries[e + kAhead]]);
+        if (profiles) lines(&profiles_[entries[e + kAhead]]);
+    }
+    if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) lines(&maps_[entries[e + kMapAhead]]);
+}
+
 void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) {
     TilePixels px;
     loadTile(tile, px);
     SlabBuffer slab;
     int64_t slabOf = std::numeric_limits<int64_t>::min();
-    // Records are a cache miss each (a tile's list is sparse in records_): fetch them 8 ahead,
-    // and an exact-index splat's map (two lines) 4 ahead, once its record has arrived.
-    constexpr size_t kAhead = 8, kMapAhead = 4;
     for (size_t e = 0; e < entries.size(); ++e) {
-        if (e + kAhead < entries.size()) __builtin_prefetch(&records_[entries[e + kAhead]]);
-        if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) {
-            const char* map = reinterpret_cast<const char*>(&maps_[entries[e + kMapAhead]]);
-            __builtin_prefetch(map), __builtin_prefetch(map + sizeof(ExactIndexMap) - 1);
-        }
+        prefetchAhead(entries, e, false);
         const uint32_t k = entries[e];
         const TileRecord& p = records_[k];
         const bool isPoint = p.kind == PrimitiveKind::Point;
@@ -424,17 +451,8 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entr
         ring.first = end;
     };
     const int64_t base = window_->slabBase;
-    constexpr size_t kAhead = 8, kMapAhead = 4;
     for (size_t e = 0; e < entries.size(); ++e) {
-        if (e + kAhead < entries.size()) {  // the record and its profile (two lines)
-            __builtin_prefetch(&records_[entries[e + kAhead]]);
-            const char* profile = reinterpret_cast<const char*>(&profiles_[entries[e + kAhead]]);
-            __builtin_prefetch(profile), __builtin_prefetch(profile + sizeof(SlabProfile) - 1);
-        }
-        if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) {
-            const char* map = reinterpret_cast<const char*>(&maps_[entries[e + kMapAhead]]);
-            __builtin_prefetch(map), __builtin_prefetch(map + sizeof(ExactIndexMap) - 1);
-        }
+        prefetchAhead(entries, e, true);
         const uint32_t k = entries[e];
         const TileRecord& p = records_[k];
         const int64_t slab = base + int64_t(p.slab);
@@ -442,20 +460,7 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entr
         // Tile-level early termination, checked every 32 primitives (open slabs of finished
         // pixels add at most ε·c; they are composited below all the same).
         if ((e & 31) == 31 && px.countLive() == 0) break;
-        SlabTargets targets;
-        const SlabProfile& profile = profiles_[k];
-        for (int j = 0; j <= 2 * reach; ++j) {
-            const float f = profile.fraction[size_t(j)];
-            if (!(f > 0.f)) continue;
-            // Never before the first open slab (only a primitive out of slab order could ask for it).
-            const int64_t to = std::max(slab - reach + j, ring.first);
-            SlabBuffer& b = ring.at(to);
-            b.dirty = true;
-            ring.last = ring.open() ? std::max(ring.last, to) : to;
-            const size_t n = size_t(targets.count++);
-            targets.tau[n] = b.tau.data(), targets.er[n] = b.er.data(), targets.eg[n] = b.eg.data(), targets.eb[n] = b.eb.data();
-            targets.fraction[n] = f;
-        }
+        const SlabTargets targets = ring.targets(profiles_[k], slab, reach);
         if (targets.count > 0) drawPrimitive(p, k, px, nullptr, &targets);
     }
     closeUpTo(closeBefore);
