@@ -77,6 +77,16 @@ constexpr RenderFlag kRenderFlags[] = {
     {"--subpixels", "K", kQuality,
      "postfilter: composite on K x K sub-pixels per pixel, 1..8 (default 1;\n"
      "2 is closer to the reference, at up to 3.5x the time at close views)"},
+    {"--compositing", "C", kQuality,
+     "kernels (default): each splat composited whole at its centre's depth,\n"
+     "points summed per one-voxel slab; slabs: every kernel's optical depth\n"
+     "spread over the depth slabs it spans along the ray, each slab\n"
+     "composited once (closer to the reference where colour changes from\n"
+     "voxel to voxel, e.g. --shading; docs/compositing.md)"},
+    {"--slab-thickness", "V", kQuality,
+     "depth slab thickness in voxels, 0.5..1 (default: 1 with --compositing\n"
+     "kernels, 0.5 with slabs): points are summed per slab, and --compositing\n"
+     "slabs composites once per slab"},
     {"--simd", "on|off", kQuality, "splats through the vector loop (default on) or the scalar table path"},
     {"--show-primitives", nullptr, kQuality, "tint splats red, points keep their colour"},
     {"--tables", "DIR", kQuality,
@@ -206,6 +216,8 @@ RenderSettings settingsFromFlags(const Args& args) {
         if (*v != "on" && *v != "off") throw Error("--lod-blend: expected 'on' or 'off', got '" + *v + "'");
         s.lodBlend = *v == "on";
     }
+    if (auto v = args.get("--compositing")) s.compositing = parseCompositingOrder(*v);
+    if (auto v = args.get("--slab-thickness")) s.slabThickness = parseDouble(*v, "--slab-thickness");
     if (auto v = args.get("--simd")) {
         if (*v != "on" && *v != "off") throw Error("--simd: expected 'on' or 'off', got '" + *v + "'");
         s.simd = *v == "on";

@@ -85,9 +85,43 @@ struct TileCompositor::SlabBuffer {
     bool dirty = false;
 };
 
-TileCompositor::TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact)
+/// --compositing slabs: one tile's open slabs [first, last] (last < first: none), slab s in
+/// slot s mod (2K + 1). Slabs before `first` are composited; a primitive of slab s deposits into
+/// s − K … s + K, so before it is drawn every slab before s − K is closed (the tile's list is in
+/// slab order, and every window's slabs follow the previous window's).
+struct TileCompositor::SlabRing {
+    int64_t first = std::numeric_limits<int64_t>::min() + 1;
+    int64_t last = std::numeric_limits<int64_t>::min();
+    std::vector<SlabBuffer> slot;
+    explicit SlabRing(int reach) : slot(size_t(2 * reach + 1)) {}
+    bool open() const { return last >= first; }
+    SlabBuffer& at(int64_t slab) {  // slabs before the eye (first < 0 near it) hold nothing, but are walked
+        const int64_t n = int64_t(slot.size()), r = slab % n;
+        return slot[size_t(r < 0 ? r + n : r)];
+    }
+    /// The slabs a primitive of slab @p slab with @p profile deposits into (those of non-zero
+    /// fraction), marked dirty and open.
+    SlabTargets targets(const SlabProfile& profile, int64_t slab, int reach) {
+        SlabTargets t;
+        for (int j = 0; j <= 2 * reach; ++j) {
+            const float f = profile.fraction[size_t(j)];
+            if (!(f > 0.f)) continue;
+            // Never before the first open slab (only a primitive out of slab order could ask for it).
+            const int64_t to = std::max(slab - reach + j, first);
+            SlabBuffer& b = at(to);
+            b.dirty = true;
+            last = open() ? std::max(last, to) : to;
+            const size_t n = size_t(t.count++);
+            t.tau[n] = b.tau.data(), t.er[n] = b.er.data(), t.eg[n] = b.eg.data(), t.eb[n] = b.eb.data();
+            t.fraction[n] = f;
+        }
+        return t;
+    }
+};
+
+TileCompositor::TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs)
     : width_(width), height_(height), tilesX_((width + kTileSize - 1) / kTileSize),
-      tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact),
+      tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact), slabs_(slabs),
       color_(size_t(width) * height), transmittance_(size_t(width) * height),  // filled below, in parallel
       liveCount_(size_t(tilesX_) * tilesY_) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, color_.size(), 16384), [&](const tbb::blocked_range<size_t>& r) {
@@ -98,7 +132,11 @@ TileCompositor::TileCompositor(int width, int height, const Tables& tables, cons
         for (int tx = 0; tx < tilesX_; ++tx)
             liveCount_[size_t(ty) * tilesX_ + tx] = (std::min(width_, (tx + 1) * kTileSize) - tx * kTileSize) *
                                                     (std::min(height_, (ty + 1) * kTileSize) - ty * kTileSize);
+    slabs_.reach = std::clamp(slabs_.reach, 0, kMaxSlabReach);
+    if (slabs_.on) rings_.resize(size_t(tilesX_) * tilesY_);
 }
+
+TileCompositor::~TileCompositor() = default;
 
 Image TileCompositor::image() const {
     Image image(width_, height_);
@@ -112,6 +150,10 @@ SkippedPrimitives TileCompositor::composite(std::span<const Primitive> prims, do
     int64_t base = std::numeric_limits<int64_t>::max();
     for (const Primitive& p : prims) base = std::min(base, p.slab);
     packed_.slabBase = prims.empty() ? 0 : base;
+    int64_t end = packed_.slabBase;
+    for (const Primitive& p : prims) end = std::max(end, p.slab + 1);
+    packed_.slabEnd = end;
+    packed_.profiles = slabs_.on;
     packed_.resize(prims.size());
     for (size_t i = 0; i < prims.size(); ++i) packed_.set(i, prims[i]);
     return composite(packed_, binSeconds, compositeSeconds);
@@ -124,11 +166,19 @@ SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, doubl
     const SkippedPrimitives skipped = binToTiles();
     binSeconds += since(t0);
     const auto t1 = Clock::now();
+    // Slabs: every slab before closeBefore is past (the next window's primitives, of slabs ≥
+    // slabEnd, reach back to slabEnd − K); tiles with open slabs and no primitive close them too.
+    const int64_t closeBefore = window.slabEnd - slabs_.reach;
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX_ * tilesY_, 1), [&](const tbb::blocked_range<int>& r) {
         for (int tile = r.begin(); tile < r.end(); ++tile) {
             const std::span<const uint32_t> bin(binEntries_.data() + binStart_[size_t(tile)],
                                                 binStart_[size_t(tile) + 1] - binStart_[size_t(tile)]);
-            if (!bin.empty()) compositeTile(tile, bin);
+            if (slabs_.on) {
+                const SlabRing* ring = rings_[size_t(tile)].get();
+                if (!bin.empty() || (ring && ring->open() && ring->first < closeBefore)) compositeTileSlabs(tile, bin, closeBefore);
+            } else if (!bin.empty()) {
+                compositeTile(tile, bin);
+            }
         }
     });
     compositeSeconds += since(t1);
@@ -180,6 +230,7 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
     // Buffers grow only (default-initialised: nothing is written until the parallel passes).
     growDiscarding(order_, total), growDiscarding(sortScratch_, total);
     growDiscarding(records_, total), growDiscarding(maps_, total);
+    if (window.profiles) growDiscarding(profiles_, total);
     orderCount_ = total;
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         size_t k = cursor[c];
@@ -220,6 +271,7 @@ SkippedPrimitives TileCompositor::binToTiles() {
             const uint32_t i = order_[k].index;
             const TileRecord& p = records_[k] = window.records[i];
             if (p.hasExactMap) maps_[k] = window.extra[i].exactMap;
+            if (window.profiles) profiles_[k] = window.profile[i];
             bool any = false;
             forTiles(p.range, [&](size_t tile) { ++count[tile], any = true; });
             if (!any) {
@@ -287,8 +339,7 @@ struct TileCompositor::TilePixels {
     }
 };
 
-void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) {
-    TilePixels px;
+void TileCompositor::loadTile(int tile, TilePixels& px) const {
     px.x0 = (tile % tilesX_) * kTileSize, px.y0 = (tile / tilesX_) * kTileSize;
     px.x1 = std::min(width_, px.x0 + kTileSize) - 1, px.y1 = std::min(height_, px.y0 + kTileSize) - 1;
     px.T.fill(0.f);  // pixels past the image's edge: finished (T = 0), never drawn
@@ -299,60 +350,157 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
             px.T[i] = transmittance_[k];
             px.R[i] = color_[k].x, px.G[i] = color_[k].y, px.B[i] = color_[k].z;
         }
-    SlabBuffer slab;
-    int64_t slabOf = std::numeric_limits<int64_t>::min();
-    const auto flush = [&] {
-        if (!slab.dirty) return;
-        for (int y = px.y0; y <= px.y1; ++y)
-            for (int x = px.x0; x <= px.x1; ++x) {
-                const int i = px.local(x, y);
-                const size_t j = size_t(i);
-                const float tau = slab.tau[j];
-                if (tau > 0.f) px.over(i, tau, glm::vec3(slab.er[j], slab.eg[j], slab.eb[j]) / tau);
-                slab.tau[j] = 0.f, slab.er[j] = 0.f, slab.eg[j] = 0.f, slab.eb[j] = 0.f;
-            }
-        slab.dirty = false;
-    };
-    // Records are a cache miss each (a tile's list is sparse in records_): fetch them 8 ahead,
-    // and an exact-index splat's map (two lines) 4 ahead, once its record has arrived.
-    constexpr size_t kAhead = 8, kMapAhead = 4;
-    for (size_t e = 0; e < entries.size(); ++e) {
-        if (e + kAhead < entries.size()) __builtin_prefetch(&records_[entries[e + kAhead]]);
-        if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) {
-            const char* map = reinterpret_cast<const char*>(&maps_[entries[e + kMapAhead]]);
-            __builtin_prefetch(map), __builtin_prefetch(map + sizeof(ExactIndexMap) - 1);
-        }
-        const uint32_t k = entries[e];
-        const TileRecord& p = records_[k];
-        const bool isPoint = p.kind == PrimitiveKind::Point;
-        if (int64_t(p.slab) != slabOf || !isPoint) {
-            flush();
-            slabOf = p.slab;
-        }
-        // Tile-level early termination, checked every 32 primitives.
-        if ((e & 31) == 31 && !slab.dirty && px.countLive() == 0) break;
-        switch (p.kind) {
-            case PrimitiveKind::Point: drawPoint(p, px, slab); break;
-            case PrimitiveKind::Splat: drawSplat(p, maps_[k], px); break;
-            case PrimitiveKind::SplatExactIndex:  // without its map: the half-ray fallback
-                p.hasExactMap ? drawSplat(p, maps_[k], px) : drawExact(p, window_->extra[order_[k].index], px);
-                break;
-            case PrimitiveKind::SplatExact:
-            case PrimitiveKind::NearEye: drawExact(p, window_->extra[order_[k].index], px); break;
-            case PrimitiveKind::Culled: break;
-        }
-    }
-    flush();
+}
+
+void TileCompositor::storeTile(int tile, const TilePixels& px) {
     for (int y = px.y0; y <= px.y1; ++y)
         for (int x = px.x0; x <= px.x1; ++x) {
             const size_t i = size_t(px.local(x, y)), k = size_t(y) * width_ + x;
             transmittance_[k] = px.T[i];
             color_[k] = glm::vec3(px.R[i], px.G[i], px.B[i]);
         }
-    liveCount_[tile] = px.countLive();
+    liveCount_[size_t(tile)] = px.countLive();
 }
 
-void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBuffer& slab) const {
+namespace {
+/// One "over" per pixel with the slab's summed optical depth and colour Σ τc / Σ τ, then the
+/// slab is emptied (DESIGN §4). @p skipFinished: pixels already finished (T < ε) take nothing
+/// (the slab order, whose slabs are composited after later primitives were deposited; in the
+/// kernel order a slab's pixels were all live when it was filled and still are).
+template <class Pixels, class Slab>
+void compositeSlab(Pixels& px, Slab& slab, bool skipFinished = false) {
+    if (!slab.dirty) return;
+    for (int y = px.y0; y <= px.y1; ++y)
+        for (int x = px.x0; x <= px.x1; ++x) {
+            const int i = px.local(x, y);
+            const size_t j = size_t(i);
+            const float tau = slab.tau[j];
+            if (tau > 0.f && (!skipFinished || px.live(i))) px.over(i, tau, glm::vec3(slab.er[j], slab.eg[j], slab.eb[j]) / tau);
+            slab.tau[j] = 0.f, slab.er[j] = 0.f, slab.eg[j] = 0.f, slab.eb[j] = 0.f;
+        }
+    slab.dirty = false;
+}
+}  // namespace
+
+void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t k, TilePixels& px, SlabBuffer* slab,
+                                   const SlabTargets* slabs) const {
+    switch (p.kind) {
+        case PrimitiveKind::Point: drawPoint(p, px, slab, slabs); break;
+        case PrimitiveKind::Splat: drawSplat(p, maps_[k], px, slabs); break;
+        case PrimitiveKind::SplatExactIndex:  // without its map: the half-ray fallback
+            p.hasExactMap ? drawSplat(p, maps_[k], px, slabs) : drawExact(p, window_->extra[order_[k].index], px, slabs);
+            break;
+        case PrimitiveKind::SplatExact:
+        case PrimitiveKind::NearEye: drawExact(p, window_->extra[order_[k].index], px, slabs); break;
+        case PrimitiveKind::Culled: break;
+    }
+}
+
+/// Records are a cache miss each (a tile's list is sparse in records_): fetch them (and, in the
+/// slab order, their profiles) 8 ahead, and an exact-index splat's map (two lines) 4 ahead, once
+/// its record has arrived.
+void TileCompositor::prefetchAhead(std::span<const uint32_t> entries, size_t e, bool profiles) const {
+    constexpr size_t kAhead = 8, kMapAhead = 4;
+    const auto lines = [](const auto* p) {
+        const char* c = reinterpret_cast<const char*>(p);
+        __builtin_prefetch(c), __builtin_prefetch(c + sizeof(*p) - 1);
+    };
+    if (e + kAhead < entries.size()) {
+        __builtin_prefetch(&records_[entries[e + kAhead]]);
+        if (profiles) lines(&profiles_[entries[e + kAhead]]);
+    }
+    if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) lines(&maps_[entries[e + kMapAhead]]);
+}
+
+void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) {
+    TilePixels px;
+    loadTile(tile, px);
+    SlabBuffer slab;
+    int64_t slabOf = std::numeric_limits<int64_t>::min();
+    for (size_t e = 0; e < entries.size(); ++e) {
+        prefetchAhead(entries, e, false);
+        const uint32_t k = entries[e];
+        const TileRecord& p = records_[k];
+        const bool isPoint = p.kind == PrimitiveKind::Point;
+        if (int64_t(p.slab) != slabOf || !isPoint) {
+            compositeSlab(px, slab);
+            slabOf = p.slab;
+        }
+        // Tile-level early termination, checked every 32 primitives.
+        if ((e & 31) == 31 && !slab.dirty && px.countLive() == 0) break;
+        drawPrimitive(p, k, px, &slab, nullptr);
+    }
+    compositeSlab(px, slab);
+    storeTile(tile, px);
+}
+
+/// --compositing slabs: each primitive's τ goes to the slabs s − K … s + K of its profile; slabs
+/// before s − K are composited first, in order, and at the end every slab before @p closeBefore
+/// (no later window reaches it). A tile that turned opaque composites and drops all it holds.
+void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entries, int64_t closeBefore) {
+    std::unique_ptr<SlabRing>& owned = rings_[size_t(tile)];
+    if (!owned) owned = std::make_unique<SlabRing>(slabs_.reach);
+    SlabRing& ring = *owned;
+    TilePixels px;
+    loadTile(tile, px);
+    const int reach = slabs_.reach;
+    const auto closeUpTo = [&](int64_t end) {  // composites the open slabs before `end`
+        if (ring.first >= end) return;
+        if (ring.open())
+            for (int64_t s = ring.first; s < end && s <= ring.last; ++s) closeSlab(px, ring.at(s));
+        ring.first = end;
+    };
+    const int64_t base = window_->slabBase;
+    for (size_t e = 0; e < entries.size(); ++e) {
+        prefetchAhead(entries, e, true);
+        const uint32_t k = entries[e];
+        const TileRecord& p = records_[k];
+        const int64_t slab = base + int64_t(p.slab);
+        closeUpTo(slab - reach);
+        // Tile-level early termination, checked every 32 primitives (open slabs of finished
+        // pixels add at most ε·c; they are composited below all the same).
+        if ((e & 31) == 31 && px.countLive() == 0) break;
+        const SlabTargets targets = ring.targets(profiles_[k], slab, reach);
+        if (targets.count > 0) drawPrimitive(p, k, px, nullptr, &targets);
+    }
+    closeUpTo(closeBefore);
+    const bool opaque = px.countLive() == 0;
+    if (opaque && ring.open()) closeUpTo(ring.last + 1);
+    // The ring stays with its tile until finish() (its slots are empty again once composited, and
+    // allocating, zeroing, 2K + 1 slabs anew for every window cost more than the tile's work),
+    // unless the tile is opaque: no primitive reaches it any more (binning skips it).
+    storeTile(tile, px);
+    if (opaque) owned.reset();
+}
+
+void TileCompositor::closeSlab(TilePixels& px, SlabBuffer& slab) const {
+    if (!slab.dirty) return;
+    if (!exact_.vector) {
+        compositeSlab(px, slab, true);
+        return;
+    }
+    compositeSlabVector(slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.buffers(), kTransmittanceEpsilon);
+    slab.dirty = false;
+}
+
+void TileCompositor::finish() {
+    if (!slabs_.on) return;
+    tbb::parallel_for(tbb::blocked_range<int>(0, tilesX_ * tilesY_, 1), [&](const tbb::blocked_range<int>& r) {
+        for (int tile = r.begin(); tile < r.end(); ++tile) {
+            std::unique_ptr<SlabRing>& ring = rings_[size_t(tile)];
+            if (!ring) continue;
+            if (ring->open()) {
+                TilePixels px;
+                loadTile(tile, px);
+                for (int64_t s = ring->first; s <= ring->last; ++s) closeSlab(px, ring->at(s));
+                storeTile(tile, px);
+            }
+            ring.reset();
+        }
+    });
+}
+
+void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBuffer* slab, const SlabTargets* slabs) const {
     // The filter was set up at projection (PointSetup): only this tile's pixels are evaluated.
     PointRaster r;
     r.cx = p.centre.x, r.cy = p.centre.y;
@@ -362,12 +510,35 @@ void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBu
     r.y0 = std::max(p.range.y0, px.y0), r.y1 = std::min(p.range.y1, px.y1);
     r.epsilon = kTransmittanceEpsilon;
     r.table = &standardPointFilterTable();
-    const SlabTile tile{slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.T.data(), px.x0, px.y0};
+    if (slabs) {
+        exact_.vector ? drawPointSlabsVector(r, *slabs, px.T.data(), px.x0, px.y0)
+                      : drawPointSlabsScalar(r, *slabs, px.T.data(), px.x0, px.y0);
+        return;
+    }
+    const SlabTile tile{slab->tau.data(), slab->er.data(), slab->eg.data(), slab->eb.data(), px.T.data(), px.x0, px.y0};
     exact_.vector ? drawPointVector(r, tile) : drawPointScalar(r, tile);
-    slab.dirty = true;
+    slab->dirty = true;
 }
 
-void TileCompositor::drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& px) const {
+namespace {
+/// Where the scalar paths put one pixel's τ: "over" (kernel order) or the slab sums.
+template <class Pixels>
+void depositAt(Pixels& px, int i, float tau, const glm::vec3& color, const SlabTargets* slabs) {
+    if (!slabs) {
+        px.over(i, tau, color);
+        return;
+    }
+    for (int j = 0; j < slabs->count; ++j) {
+        const float t = tau * slabs->fraction[size_t(j)];
+        slabs->tau[size_t(j)][i] += t;
+        slabs->er[size_t(j)][i] += t * color.x;
+        slabs->eg[size_t(j)][i] += t * color.y;
+        slabs->eb[size_t(j)][i] += t * color.z;
+    }
+}
+}  // namespace
+
+void TileCompositor::drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& px, const SlabTargets* slabs) const {
     const bool exactIndex = p.kind == PrimitiveKind::SplatExactIndex;
     if (exact_.vector && (exactIndex || tables_.poly.covers(p.sin2Alpha))) {
         SplatRaster s;
@@ -381,13 +552,14 @@ void TileCompositor::drawSplat(const TileRecord& p, const ExactIndexMap& map, Ti
         s.x0 = std::max(p.range.x0, px.x0), s.x1 = std::min(p.range.x1, px.x1);
         s.y0 = std::max(p.range.y0, px.y0), s.y1 = std::min(p.range.y1, px.y1);
         s.epsilon = kTransmittanceEpsilon;
+        s.slabs = slabs;
         drawSplatVector(s, px.buffers());
         return;
     }
-    drawSplatTables(p, map, px);
+    drawSplatTables(p, map, px, slabs);
 }
 
-void TileCompositor::drawSplatTables(const TileRecord& p, const ExactIndexMap& map, TilePixels& px) const {
+void TileCompositor::drawSplatTables(const TileRecord& p, const ExactIndexMap& map, TilePixels& px, const SlabTargets* slabs) const {
     // SplatExactIndex (--footprint auto, far off the axis): the exact index d instead of the
     // affine one, from the affine map set up once at projection (ExactIndexMap).
     const bool exactIndex = p.kind == PrimitiveKind::SplatExactIndex;
@@ -415,12 +587,12 @@ void TileCompositor::drawSplatTables(const TileRecord& p, const ExactIndexMap& m
             const float i2 = qxx * dx * dx + 2.f * qxy * dx * dy + qyy * dy * dy;
             if (!(i2 < 1.f)) continue;
             const float tau = exactIndex ? shader.depositAtD2(map.d2(dx, dy)) : shader.depositAtIndex2(i2);
-            px.over(i, tau, p.color);
+            depositAt(px, i, tau, p.color, slabs);
         }
     }
 }
 
-void TileCompositor::drawExact(const TileRecord& p, const PrimitiveExtra& extra, TilePixels& px) const {
+void TileCompositor::drawExact(const TileRecord& p, const PrimitiveExtra& extra, TilePixels& px, const SlabTargets* slabs) const {
     const Camera& camera = *exact_.camera;
     if (exact_.shape && !exact_.shape->sphere) {  // an ellipsoid at the eye: the exact half-ray integral
         const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
@@ -431,7 +603,7 @@ void TileCompositor::drawExact(const TileRecord& p, const PrimitiveExtra& extra,
                 const int i = px.local(x, y);
                 if (!px.live(i)) continue;
                 const double tau = extra.sigma * ellipsoidHalfRayDeposit(*exact_.shape, c, camera.viewRay(PixelCoord(x + 0.5, y + 0.5)));
-                if (tau > 0.0) px.over(i, float(tau), p.color);
+                if (tau > 0.0) depositAt(px, i, float(tau), p.color, slabs);
             }
         return;
     }
@@ -453,7 +625,7 @@ void TileCompositor::drawExact(const TileRecord& p, const PrimitiveExtra& extra,
             const PixelCoord q(x + 0.5, y + 0.5);
             const double tau =
                 widened ? splatDepositExact(kernel, sphere, sigmaWorld, h, q, shape) : extra.sigma * halfRayFootprint(sphere, q, shape);
-            if (tau > 0.0) px.over(i, float(tau), p.color);
+            if (tau > 0.0) depositAt(px, i, float(tau), p.color, slabs);
         }
 }
 

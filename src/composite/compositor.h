@@ -11,12 +11,18 @@
 //   - a pixel whose T < ε takes no more work; a tile whose pixels all have
 //     T < ε takes no more primitives, and blocks hidden behind such tiles are
 //     never streamed (hidden()).
+// With --compositing slabs (SlabCompositing, docs/compositing.md) every primitive instead deposits
+// its optical depth and σ-weighted colour into the slabs its kernel spans (its SlabProfile), each
+// tile keeps the slabs still open in a ring that persists from window to window, and a slab is
+// composited once ("over" with the summed τ) as soon as no later primitive can reach it.
 // The order inside a tile is a total order independent of threads, so the image
 // does not depend on the thread count.
 #pragma once
+#include <memory>
 #include <span>
 #include <vector>
 
+#include "composite/compositing.h"
 #include "composite/primitive.h"
 #include "footprint/ellipse.h"
 #include "footprint/ellipsoid.h"
@@ -55,7 +61,8 @@ struct SkippedPrimitives {
 
 class TileCompositor {
 public:
-    TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact);
+    TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs = {});
+    ~TileCompositor();
 
     /// @brief Composites @p window (one depth window, any order) behind everything before.
     /// @return the primitives skipped because every tile they touch is opaque.
@@ -71,7 +78,12 @@ public:
         return true;
     }
 
-    /// @brief The image so far: premultiplied colour, alpha = 1 − T.
+    /// @brief Composites every slab still open (--compositing slabs: the last windows' slabs wait
+    /// for the next window's primitives, whose kernels may reach back into them). Call it after
+    /// the last window; nothing to do in the kernel order.
+    void finish();
+
+    /// @brief The image so far: premultiplied colour, alpha = 1 − T (after finish(): everything).
     Image image() const;
 
 private:
@@ -84,18 +96,27 @@ private:
     /// in sort order. The rare kinds that need more (SplatExact, NearEye) read the window's extra.
     using TileRecord = PrimitiveRecord;
     struct SlabBuffer;
+    struct SlabRing;    // --compositing slabs: one tile's open slabs, kept from window to window
     struct TilePixels;  // one tile's transmittance and colour, copied in and out (thread-local)
     void sortWindow(const ProjectedWindow& window);
     SkippedPrimitives binToTiles();
+    void loadTile(int tile, TilePixels& px) const;
+    void storeTile(int tile, const TilePixels& px);
+    void prefetchAhead(std::span<const uint32_t> entries, size_t e, bool profiles) const;
     void compositeTile(int tile, std::span<const uint32_t> entries);
-    void drawPoint(const TileRecord& p, const TilePixels& tile, SlabBuffer& slab) const;
-    void drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile) const;
-    void drawSplatTables(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile) const;
-    void drawExact(const TileRecord& p, const PrimitiveExtra& extra, TilePixels& tile) const;
+    void compositeTileSlabs(int tile, std::span<const uint32_t> entries, int64_t closeBefore);
+    void closeSlab(TilePixels& px, SlabBuffer& slab) const;  // one "over" per live pixel, then empty
+    void drawPrimitive(const TileRecord& p, uint32_t k, TilePixels& px, SlabBuffer* slab, const SlabTargets* slabs) const;
+    void drawPoint(const TileRecord& p, const TilePixels& tile, SlabBuffer* slab, const SlabTargets* slabs) const;
+    void drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile, const SlabTargets* slabs) const;
+    void drawSplatTables(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile, const SlabTargets* slabs) const;
+    void drawExact(const TileRecord& p, const PrimitiveExtra& extra, TilePixels& tile, const SlabTargets* slabs) const;
 
     int width_, height_, tilesX_, tilesY_;
     const Tables& tables_;
     ExactContext exact_;
+    SlabCompositing slabs_;
+    std::vector<std::unique_ptr<SlabRing>> rings_;  // --compositing slabs: per tile, null while none is open
     template <class T>
     using Buffer = std::vector<T, HugePageAllocator<T>>;  // large: in huge pages (util/huge_pages.h)
     Buffer<glm::vec3> color_;             // premultiplied radiance
@@ -108,6 +129,7 @@ private:
     Buffer<Entry> sortScratch_;           // the radix sort's second buffer
     Buffer<TileRecord> records_;          // ... gathered in that order
     Buffer<ExactIndexMap> maps_;          // ... their exact-index maps, where hasExactMap
+    Buffer<SlabProfile> profiles_;        // ... their slab fractions (--compositing slabs)
     std::vector<size_t> chunkCounts_;     // sortWindow's per-chunk counts and cursors
     std::vector<size_t> binStart_;        // per tile (+1): its list in binEntries_
     Buffer<uint32_t> binEntries_;    // per tile: positions in records_, ascending

@@ -22,13 +22,13 @@ constexpr int kStride = 16;  // tile row stride (kTileSize)
 
 
 template <class D>
-void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
+void DrawPointFor(D d, const PointRaster& p, const SlabTargets& slabs, const float* T, int tileX0, int tileY0) {
     using V = hn::Vec<D>;
     constexpr int N = int(hn::MaxLanes(D()));
     const hn::RebindToSigned<D> di;
     const PointFilterTable& table = *p.table;
     // The tile's columns in vectors of N: the first and last that hold footprint pixels.
-    const int c0 = (p.x0 - tile.x0) / N * N, c1 = (p.x1 - tile.x0) / N * N;
+    const int c0 = (p.x0 - tileX0) / N * N, c1 = (p.x1 - tileX0) / N * N;
     // Per column and per row of the footprint's part in the tile (once per point and tile): the
     // squared offset and its weight, both axes in one vector of 16 (lanes 0–7 the columns from
     // p.x0, 8–15 the rows from p.y0: one pair of gathers), then put on the tile's lanes.
@@ -51,39 +51,42 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTile& tile) {
     // The columns on the tile's lanes: lanes past the footprint's part hold other columns' values
     // (or zeros), masked off below.
     alignas(64) float dx2s[kStride + 8] = {}, gxs[kStride + 8] = {};
-    const int at = p.x0 - tile.x0;
+    const int at = p.x0 - tileX0;
     std::copy_n(sq, 8, dx2s + at), std::copy_n(g, 8, gxs + at);
     const V eps = hn::Set(d, p.epsilon), rs2 = hn::Set(d, p.radius2), total = hn::Set(d, p.total),
             norm = hn::Set(d, p.norm);
     const V cr = hn::Set(d, p.color.x), cg = hn::Set(d, p.color.y), cb = hn::Set(d, p.color.z);
-    const auto before = hn::Set(di, p.x0 - tile.x0 - 1), after = hn::Set(di, p.x1 - tile.x0 + 1);
+    const auto before = hn::Set(di, p.x0 - tileX0 - 1), after = hn::Set(di, p.x1 - tileX0 + 1);
     for (int y = p.y0; y <= p.y1; ++y) {
-        const int ly = y - p.y0, row = (y - tile.y0) * kStride;
+        const int ly = y - p.y0, row = (y - tileY0) * kStride;
         const V gy = hn::Set(d, g[8 + ly]), vdy2 = hn::Set(d, sq[8 + ly]);
         for (int c = c0; c <= c1; c += N) {
             const auto col = hn::Iota(di, c);
             const auto inRange = hn::RebindMask(d, hn::And(hn::Gt(col, before), hn::Lt(col, after)));
             const V dx2 = hn::Load(d, dx2s + c);
-            const auto mask = hn::And(hn::And(inRange, hn::Ge(hn::Load(d, tile.T + row + c), eps)),
+            const auto mask = hn::And(hn::And(inRange, hn::Ge(hn::Load(d, T + row + c), eps)),
                                       hn::Lt(hn::Add(dx2, vdy2), rs2));
             if (hn::AllFalse(d, mask)) continue;
-            const V tau = hn::Mul(total, hn::Mul(hn::Mul(hn::Load(d, gxs + c), gy), norm));
-            float* const pt = tile.tau + row + c;
-            float* const pr = tile.er + row + c;
-            float* const pg = tile.eg + row + c;
-            float* const pb = tile.eb + row + c;
-            const V t0 = hn::Load(d, pt), r0v = hn::Load(d, pr), g0 = hn::Load(d, pg), b0 = hn::Load(d, pb);
-            hn::Store(hn::IfThenElse(mask, hn::Add(t0, tau), t0), d, pt);
-            hn::Store(hn::IfThenElse(mask, hn::Add(r0v, hn::Mul(tau, cr)), r0v), d, pr);
-            hn::Store(hn::IfThenElse(mask, hn::Add(g0, hn::Mul(tau, cg)), g0), d, pg);
-            hn::Store(hn::IfThenElse(mask, hn::Add(b0, hn::Mul(tau, cb)), b0), d, pb);
+            const V tauAll = hn::Mul(total, hn::Mul(hn::Mul(hn::Load(d, gxs + c), gy), norm));
+            for (int j = 0; j < slabs.count; ++j) {  // one slab (fraction 1) but with --compositing slabs
+                const V tau = hn::Mul(tauAll, hn::Set(d, slabs.fraction[size_t(j)]));
+                float* const pt = slabs.tau[size_t(j)] + row + c;
+                float* const pr = slabs.er[size_t(j)] + row + c;
+                float* const pg = slabs.eg[size_t(j)] + row + c;
+                float* const pb = slabs.eb[size_t(j)] + row + c;
+                const V t0 = hn::Load(d, pt), r0v = hn::Load(d, pr), g0 = hn::Load(d, pg), b0 = hn::Load(d, pb);
+                hn::Store(hn::IfThenElse(mask, hn::Add(t0, tau), t0), d, pt);
+                hn::Store(hn::IfThenElse(mask, hn::Add(r0v, hn::Mul(tau, cr)), r0v), d, pr);
+                hn::Store(hn::IfThenElse(mask, hn::Add(g0, hn::Mul(tau, cg)), g0), d, pg);
+                hn::Store(hn::IfThenElse(mask, hn::Add(b0, hn::Mul(tau, cb)), b0), d, pb);
+            }
         }
     }
 }
 
-void DrawPoint(const PointRaster& p, const SlabTile& tile) {
+void DrawPointSlabs(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0) {
     if (p.x0 > p.x1 || p.y0 > p.y1) return;
-    DrawPointFor(hn::CappedTag<float, kStride>(), p, tile);
+    DrawPointFor(hn::CappedTag<float, kStride>(), p, slabs, T, x0, y0);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -93,29 +96,50 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace vdbsplat {
 
-HWY_EXPORT(DrawPoint);
+HWY_EXPORT(DrawPointSlabs);
 
-void drawPointVector(const PointRaster& p, const SlabTile& tile) { HWY_DYNAMIC_DISPATCH(DrawPoint)(p, tile); }
+namespace {
+SlabTargets oneSlab(const SlabTile& tile) {
+    SlabTargets t;
+    t.count = 1;
+    t.tau[0] = tile.tau, t.er[0] = tile.er, t.eg[0] = tile.eg, t.eb[0] = tile.eb;
+    t.fraction[0] = 1.f;
+    return t;
+}
+}  // namespace
 
-void drawPointScalar(const PointRaster& p, const SlabTile& tile) {
+void drawPointSlabsVector(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0) {
+    HWY_DYNAMIC_DISPATCH(DrawPointSlabs)(p, slabs, T, x0, y0);
+}
+
+void drawPointVector(const PointRaster& p, const SlabTile& tile) {
+    drawPointSlabsVector(p, oneSlab(tile), tile.T, tile.x0, tile.y0);
+}
+
+void drawPointSlabsScalar(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0) {
     constexpr int kStride = 16;
     const PointFilterTable& table = *p.table;
     for (int y = p.y0; y <= p.y1; ++y) {
         const float dy = PointSetup::offset(y, p.cy), dy2 = dy * dy;
         const float gy = table.weight(dy2 * p.invVariance);
         for (int x = p.x0; x <= p.x1; ++x) {
-            const int i = (y - tile.y0) * kStride + (x - tile.x0);
-            if (!(tile.T[i] >= p.epsilon)) continue;
+            const int i = (y - y0) * kStride + (x - x0);
+            if (!(T[i] >= p.epsilon)) continue;
             const float dx = PointSetup::offset(x, p.cx), dx2 = dx * dx;
             const float w = dx2 + dy2 < p.radius2 ? table.weight(dx2 * p.invVariance) * gy : 0.0f;
-            const float tau = p.total * (w * p.norm);
-            tile.tau[i] += tau;
-            tile.er[i] += tau * p.color.x;
-            tile.eg[i] += tau * p.color.y;
-            tile.eb[i] += tau * p.color.z;
+            const float tauAll = p.total * (w * p.norm);
+            for (int j = 0; j < slabs.count; ++j) {
+                const float tau = tauAll * slabs.fraction[size_t(j)];
+                slabs.tau[size_t(j)][i] += tau;
+                slabs.er[size_t(j)][i] += tau * p.color.x;
+                slabs.eg[size_t(j)][i] += tau * p.color.y;
+                slabs.eb[size_t(j)][i] += tau * p.color.z;
+            }
         }
     }
 }
+
+void drawPointScalar(const PointRaster& p, const SlabTile& tile) { drawPointSlabsScalar(p, oneSlab(tile), tile.T, tile.x0, tile.y0); }
 
 }  // namespace vdbsplat
 #endif  // HWY_ONCE

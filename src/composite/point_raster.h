@@ -14,6 +14,7 @@
 #pragma once
 #include <glm/glm.hpp>
 
+#include "composite/slab_profile.h"
 #include "pointfilter/point_filter.h"
 
 namespace vdbsplat {
@@ -46,5 +47,12 @@ void drawPointVector(const PointRaster& p, const SlabTile& tile);
 
 /// @brief The same, one pixel at a time (the oracle).
 void drawPointScalar(const PointRaster& p, const SlabTile& tile);
+
+/// @brief --compositing slabs: the point's deposits into several slabs of one tile, slab j taking
+/// fraction j of each pixel's τ (@p T, @p x0, @p y0: the tile's transmittance and first pixel).
+/// With one target of fraction 1 this is drawPointVector, bit for bit.
+void drawPointSlabsVector(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0);
+/// @brief The same, one pixel at a time (the oracle).
+void drawPointSlabsScalar(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0);
 
 }  // namespace vdbsplat

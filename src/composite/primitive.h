@@ -14,6 +14,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
+#include "composite/slab_profile.h"
 #include "footprint/pixel_box.h"
 #include "footprint/screen_kernel.h"
 #include "util/huge_pages.h"
@@ -57,6 +58,9 @@ struct Primitive {
     // SplatExact / NearEye (recomputed from these per tile; they are rare or a diagnostic)
     glm::vec3 viewPos{0.f};
     float sigma = 0.f;          ///< extinction per voxel length
+    /// --compositing slabs: the fractions of its optical depth for the slabs around its own
+    /// (composite/slab_profile.h), set by projectBatch.
+    SlabProfile profile;
 };
 
 /// The projected window: reused window after window, in huge pages (util/huge_pages.h).
@@ -99,16 +103,21 @@ struct ProjectedWindow {
 
     size_t size = 0;
     int64_t slabBase = 0;              ///< the first slab: records' and order's slabs are relative to it
+    int64_t slabEnd = 0;               ///< one past the window's last slab (the next window starts there or later)
+    /// --compositing slabs: each primitive's slab fractions are kept (profile[i]); false: not written.
+    bool profiles = false;
     Buffer<PrimitiveRecord> records;
     Buffer<uint32_t> order;            ///< the sort key's high part: relative slab·2 + (not a point), or kNotDrawn
     Buffer<float> depth;               ///< radial distance of the voxel centre (world units): the order in a slab
     Buffer<uint32_t> members;          ///< active voxels each stands for
     Buffer<PrimitiveExtra> extra;      ///< written only where needsExtra(kind)
+    Buffer<SlabProfile> profile;       ///< written only when `profiles`
 
     /// Grows the buffers to @p n primitives (contents undefined until set()).
     void resize(size_t n) {
         growDiscarding(records, n), growDiscarding(order, n), growDiscarding(depth, n);
         growDiscarding(members, n), growDiscarding(extra, n);
+        if (profiles) growDiscarding(profile, n);
         size = n;
     }
     /// Stores @p p as primitive @p i (its slab relative to slabBase, clamped to [0, kMaxRelativeSlab]).
@@ -130,6 +139,7 @@ struct ProjectedWindow {
         depth[i] = p.depth;
         members[i] = p.members;
         if (needsExtra(p.kind)) extra[i] = PrimitiveExtra{p.exactMap, p.viewPos, p.sigma};
+        if (profiles) profile[i] = p.profile;
     }
 };
 

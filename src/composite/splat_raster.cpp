@@ -32,11 +32,10 @@ inline bool rowChord(const SplatRaster& s, float dy, int& xa, int& xb) {
     return xa <= xb;
 }
 
-/// T·α of the splat at pixel offsets (dx, dy) from its centre, for the lanes of @p mask (which
-/// the exact index narrows to d² < 1): τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h),
-/// α = 1 − e^{−τ}.
+/// τ of the splat at pixel offsets (dx, dy) from its centre, for the lanes of @p mask (which
+/// the exact index narrows to d² < 1): τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h).
 template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
-HWY_INLINE V OpacityTimesT(D d, const SplatRaster& s, V dx, V dy, V i2, V T, M& mask) {
+HWY_INLINE V Tau(D d, const SplatRaster& s, V dx, V dy, V i2, M& mask) {
     const V zero = hn::Zero(d), one = hn::Set(d, 1.f), two = hn::Set(d, 2.f);
     V t;
     if (s.exactIndex) {  // d² = |w|² / |v|² / r², w = c × v (DESIGN §3; ExactIndexMap::d2)
@@ -59,9 +58,33 @@ HWY_INLINE V OpacityTimesT(D d, const SplatRaster& s, V dx, V dy, V i2, V T, M& 
     V p = hn::Set(d, s.coef[FootprintPolynomials::kDegree]);
 #pragma GCC unroll 16
     for (int j = FootprintPolynomials::kDegree - 1; j >= 0; --j) p = hn::MulAdd(p, x, hn::Set(d, s.coef[size_t(j)]));
-    const V tau = hn::Max(hn::Mul(hn::Mul(hn::Set(d, s.scale), hn::Sqrt(hn::Sub(one, t))), p), zero);
+    return hn::Max(hn::Mul(hn::Mul(hn::Set(d, s.scale), hn::Sqrt(hn::Sub(one, t))), p), zero);
+}
+
+/// T·α of the splat (Tau), α = 1 − e^{−τ}.
+template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
+HWY_INLINE V OpacityTimesT(D d, const SplatRaster& s, V dx, V dy, V i2, V T, M& mask) {
+    const V tau = Tau(d, s, dx, dy, i2, mask);
     const V alpha = hn::Neg(hn::Expm1(d, hn::Neg(tau)));  // 1 − e^{−τ}
     return hn::Mul(T, alpha);
+}
+
+/// --compositing slabs: τ·fraction_j and τ·fraction_j·c added to slab j's sums at the lanes of
+/// @p mask; @p load and @p store read and write one vector of a tile array at the lanes' pixels.
+template <class D, class V, class M, class Load, class Store>
+HWY_INLINE void DepositSlabs(D d, const SplatRaster& s, V tau, M mask, const Load& load, const Store& store) {
+    const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
+    const SlabTargets& slabs = *s.slabs;
+    // Lanes outside the mask add 0 (exactly: x + 0 = x, and 0·c + x = x for finite c).
+    const V tauIn = hn::IfThenElseZero(mask, tau);
+    for (int j = 0; j < slabs.count; ++j) {
+        const V tj = hn::Mul(tauIn, hn::Set(d, slabs.fraction[size_t(j)]));
+        float *pt = slabs.tau[size_t(j)], *pr = slabs.er[size_t(j)], *pg = slabs.eg[size_t(j)], *pb = slabs.eb[size_t(j)];
+        store(pt, hn::Add(load(pt), tj));
+        store(pr, hn::MulAdd(tj, cr, load(pr)));
+        store(pg, hn::MulAdd(tj, cg, load(pg)));
+        store(pb, hn::MulAdd(tj, cb, load(pb)));
+    }
 }
 
 /// i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²
@@ -94,6 +117,12 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
             const V T = hn::Load(d, pt);
             auto mask = hn::And(hn::And(hn::Ge(xPix, lo), hn::Lt(xPix, hi)), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
             if (hn::AllFalse(d, mask)) continue;
+            if (s.slabs) {
+                const V tau = Tau(d, s, dx, dy, i2, mask);
+                DepositSlabs(d, s, tau, mask, [&](float* base) { return hn::Load(d, base + row + c); },
+                             [&](float* base, V v) { hn::Store(v, d, base + row + c); });
+                continue;
+            }
             const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
             float *pr = tile.R + row + c, *pg = tile.G + row + c, *pb = tile.B + row + c;
             hn::Store(hn::IfThenElse(mask, hn::MulAdd(ta, cr, hn::Load(d, pr)), hn::Load(d, pr)), d, pr);
@@ -135,11 +164,15 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const int*
         auto mask = hn::And(hn::And(hn::Ge(xPix, lo), hn::Lt(xPix, hi)), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
         if (!pair) mask = hn::And(mask, hn::FirstN(d, kHalf));
         if (hn::AllFalse(d, mask)) continue;
-        const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
         const auto store = [&](float* base, V value) {
             hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
             if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
+        if (s.slabs) {
+            DepositSlabs(d, s, Tau(d, s, dx, dy, i2, mask), mask, [&](float* base) { return load(base); }, store);
+            continue;
+        }
+        const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
         const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
         store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, cr, R), R));
         store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, cg, G), G));
@@ -195,6 +228,28 @@ void DrawSplatRowsFor(D d, const SplatRaster& s, const TileBuffers& tile) {
 
 void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) { DrawSplatRowsFor(hn::CappedTag<float, kStride>(), s, tile); }
 
+/// One slab over the tile's live pixels, then emptied (compositeSlabVector).
+void CompositeSlab(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon) {
+    const hn::CappedTag<float, kStride> d;
+    using V = hn::Vec<decltype(d)>;
+    const int n = int(hn::Lanes(d));
+    const V zero = hn::Zero(d), eps = hn::Set(d, epsilon);
+    for (int i = 0; i < kStride * kStride; i += n) {
+        const V t = hn::Load(d, tau + i);
+        const V T = hn::Load(d, tile.T + i);
+        const auto mask = hn::And(hn::Gt(t, zero), hn::Ge(T, eps));
+        if (!hn::AllFalse(d, mask)) {
+            const V ta = hn::Mul(T, hn::Neg(hn::Expm1(d, hn::Neg(t))));  // T·α
+            const V w = hn::IfThenElseZero(mask, hn::Div(ta, hn::IfThenElse(mask, t, hn::Set(d, 1.f))));
+            hn::Store(hn::MulAdd(w, hn::Load(d, er + i), hn::Load(d, tile.R + i)), d, tile.R + i);
+            hn::Store(hn::MulAdd(w, hn::Load(d, eg + i), hn::Load(d, tile.G + i)), d, tile.G + i);
+            hn::Store(hn::MulAdd(w, hn::Load(d, eb + i), hn::Load(d, tile.B + i)), d, tile.B + i);
+            hn::Store(hn::IfThenElse(mask, hn::Sub(T, ta), T), d, tile.T + i);
+        }
+        hn::Store(zero, d, tau + i), hn::Store(zero, d, er + i), hn::Store(zero, d, eg + i), hn::Store(zero, d, eb + i);
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace vdbsplat
 HWY_AFTER_NAMESPACE();
@@ -203,6 +258,11 @@ HWY_AFTER_NAMESPACE();
 namespace vdbsplat {
 
 HWY_EXPORT(DrawSplatRows);
+HWY_EXPORT(CompositeSlab);
+
+void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon) {
+    HWY_DYNAMIC_DISPATCH(CompositeSlab)(tau, er, eg, eb, tile, epsilon);
+}
 
 void drawSplatVector(const SplatRaster& s, const TileBuffers& tile) { HWY_DYNAMIC_DISPATCH(DrawSplatRows)(s, tile); }
 
@@ -218,6 +278,17 @@ void drawSplatScalarPoly(const SplatRaster& s, const TileBuffers& tile) {
             if (!(i2 < 1.f)) continue;
             const float t = s.exactIndex ? s.map.d2(dx, dy) : i2;
             const float tau = s.scale * FootprintPolynomials::evaluate(s.coef, t);
+            if (s.slabs) {
+                if (s.exactIndex && !(t < 1.f)) continue;  // as the vector loop's mask
+                for (int j = 0; j < s.slabs->count; ++j) {
+                    const float tj = tau * s.slabs->fraction[size_t(j)];
+                    s.slabs->tau[size_t(j)][i] += tj;
+                    s.slabs->er[size_t(j)][i] += tj * s.color.x;
+                    s.slabs->eg[size_t(j)][i] += tj * s.color.y;
+                    s.slabs->eb[size_t(j)][i] += tj * s.color.z;
+                }
+                continue;
+            }
             const float alpha = opacityFromOpticalDepth(tau);
             const float ta = tile.T[i] * alpha;
             tile.R[i] += ta * s.color.x;

@@ -11,10 +11,12 @@
 //     t  = i² (table path) or the exact d² (ExactIndexMap, --footprint auto off the axis)
 //     τ  = scale · √(1 − t) · G_α(t)             (scale = σ·h·amplitude; DESIGN §3, §4)
 //     α  = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α  (DESIGN §4, front to back)
+// or, with `slabs` (--compositing slabs), τ·fraction_j and τ·fraction_j·c added to slab j's sums.
 // Pixels with i² ≥ 1, outside the splat's clipped range or already opaque (T < ε) keep their values.
 #pragma once
 #include <glm/glm.hpp>
 
+#include "composite/slab_profile.h"
 #include "footprint/footprint_poly.h"
 #include "footprint/screen_kernel.h"
 
@@ -39,10 +41,18 @@ struct SplatRaster {
     glm::vec3 color{0.f};
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  ///< inclusive image pixels, inside the tile
     float epsilon = 0.f;                  ///< pixels with T < epsilon are finished
+    /// --compositing slabs: deposit τ into these slab sums (composite/slab_profile.h) instead of
+    /// compositing "over"; null: over.
+    const SlabTargets* slabs = nullptr;
 };
 
 /// @brief Composites @p s "over" the pixels of @p tile (front to back).
 void drawSplatVector(const SplatRaster& s, const TileBuffers& tile);
+
+/// @brief --compositing slabs: composites one slab of a tile (optical depth @p tau and σ-weighted
+/// emission @p er, @p eg, @p eb, 256 pixels each) onto @p tile's live pixels (T ≥ @p epsilon):
+/// α = 1 − e^{−τ}, C += T·α·e/τ, T *= 1 − α; then empties the slab. Vectorised (Highway).
+void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon);
 
 /// @brief The same loop one pixel at a time, in the same float operations (tests: the vector
 /// loop must agree with it to float rounding).

@@ -31,7 +31,22 @@ struct ForwardPass {
 Image composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, const Tables& tables,
                 const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
                 const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
+    // The kernels' shape in view space (anisotropic or sheared voxels: ellipsoids).
+    // view = R·(world − eye), R's rows right, up, forward: M = R·A.
+    const glm::dmat3 worldToView = glm::transpose(glm::dmat3(camera.right(), camera.up(), camera.forward()));
+    VoxelShape shape = VoxelShape::of(worldToView * glm::dmat3(volume.indexToWorld));
+    shape.sphere = volume.isotropic;
     StreamOptions streamOptions = settings.stream;
+    streamOptions.slabThickness = settings.effectiveSlabThickness();
+    const bool slabOrder = settings.compositing == CompositingOrder::Slabs;
+    // The slab order's automatic thickness (½ voxel) is widened for elongated kernels so that a
+    // kernel spans at most 2·kMaxSlabReach slabs (R·sMax ≤ K·slab): voxels 1×1×2.5 get 0.92.
+    if (slabOrder && settings.slabThickness == 0.0)
+        streamOptions.slabThickness = std::max(streamOptions.slabThickness,
+                                               tables.kernel->radius() * shape.sMax / (kMaxSlabReach * volume.voxelSize));
+    // Windows of the same depth whatever the slab: 8 voxels' worth of slabs (the window's voxel
+    // bounds still narrow it; windows split only at slab boundaries, so the image is the same).
+    streamOptions.slabsPerWindow = int(std::lround(streamOptions.slabsPerWindow / streamOptions.slabThickness));
     streamOptions.lodCellPx = pass.lodPx;
     streamOptions.lodBlend = settings.lodBlend;
     streamOptions.pointPrefilterVariance = pass.prefilterVariance;
@@ -39,20 +54,25 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
                                  : drawsOnlySplats(settings.mode)   ? 0.0
                                                                     : pass.threshold;
     VoxelStream stream(volume, camera, table, streamOptions, shader, emission);
-    // The kernels' shape in view space (anisotropic or sheared voxels: ellipsoids).
-    // view = R·(world − eye), R's rows right, up, forward: M = R·A.
-    const glm::dmat3 worldToView = glm::transpose(glm::dmat3(camera.right(), camera.up(), camera.forward()));
-    VoxelShape shape = VoxelShape::of(worldToView * glm::dmat3(volume.indexToWorld));
-    shape.sphere = volume.isotropic;
     ExactContext exact{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance};
     exact.shape = &shape;
-    TileCompositor compositor(camera.width(), camera.height(), tables, exact);
+    // --compositing slabs: a kernel reaches R·(its longest semi-axis per index unit) along any
+    // ray, so K = ⌈R·sMax / slab length⌉ slabs on either side of its own (2 for cubic voxels).
+    SlabCompositing slabs;
+    if (slabOrder) {
+        slabs.on = true;
+        slabs.reach = slabReachFor(tables.kernel->radius() * shape.sMax / stream.slabLength());
+    }
+    TileCompositor compositor(camera.width(), camera.height(), tables, exact, slabs);
     ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
                           settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
                           pass.prefilterVariance};
     ctx.shape = &shape;
     ctx.occlusion = &compositor;
     ctx.vector = settings.simd;
+    ctx.slabs = slabs;
+    std::optional<MarginalCdfTable> marginal;
+    if (slabs.on) ctx.marginal = &marginal.emplace(*tables.kernel);
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     VoxelBatch batch;
     ProjectedWindow window;
@@ -87,6 +107,9 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     stats.windows = stream.windows();
     stats.largestWindow = stream.largestWindow();
     stats.compositedPixels = uint64_t(camera.width()) * uint64_t(camera.height());
+    auto t = Clock::now();
+    compositor.finish();
+    stats.compositeSeconds += since(t);
     return compositor.image();
 }
 

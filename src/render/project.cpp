@@ -162,8 +162,25 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
     return p;
 }
 
+SlabProfile slabProfileFor(const glm::dvec3& c, double distance, int64_t slab, float depthSpread, const ProjectionContext& ctx) {
+    const KernelShape& kernel = *ctx.tables.kernel;
+    const double length = glm::length(c);
+    const glm::dvec3 omega = length > 0.0 ? c / length : glm::dvec3(0.0, 0.0, 1.0);
+    // World length of one kernel unit along the ray: |Mᵀω| for the kernel x = M·u (its marginal
+    // along ω is the sphere's, scaled by |Mᵀω|); h for a sphere.
+    const double unit0 = ctx.shape && !ctx.shape->sphere ? glm::length(glm::transpose(ctx.shape->M) * omega) : ctx.voxelSize;
+    const double s = kernel.sigma();
+    const double unit = std::sqrt(unit0 * unit0 + double(depthSpread) / (s * s));
+    const double offset = distance / ctx.slabLength - double(slab);
+    const int lowest = int(-std::min<int64_t>(slab, kMaxSlabReach));
+    return ctx.marginal ? slabFractions(*ctx.marginal, offset, unit / ctx.slabLength, ctx.slabs.reach, lowest)
+                        : slabFractions(kernel, offset, unit / ctx.slabLength, ctx.slabs.reach, lowest);
+}
+
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window) {
     window.slabBase = batch.slabBegin;
+    window.slabEnd = batch.slabEnd;
+    window.profiles = ctx.slabs.on;
     window.resize(batch.size());
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, batch.size(), 1024), ProjectionCounts{},
@@ -174,6 +191,9 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                 p.depth = batch.distance[i];
                 p.slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
                                              batch.slabEnd - 1);
+                if (ctx.slabs.on && p.kind != PrimitiveKind::Culled)
+                    p.profile = slabProfileFor(glm::dvec3(batch.viewPos[i]), batch.distance[i], p.slab,
+                                               batch.depthSpread.empty() ? 0.f : batch.depthSpread[i], ctx);
                 window.set(i, p);
                 if (p.kind == PrimitiveKind::Culled) continue;
                 ++(p.kind == PrimitiveKind::Point ? c.points : c.splats);

@@ -48,6 +48,11 @@ struct ProjectionContext {
     /// Points' filter set up through the vector sum (setupPointVector); false: setupPoint, the
     /// scalar oracle (--simd off). The same values either way.
     bool vector = true;
+    /// --compositing slabs: each drawn primitive gets the fractions of its optical depth for the
+    /// slabs around its own (composite/slab_profile.h; `reach` as the compositor's), from the
+    /// kernel's tabulated marginal `marginal` (required when slabs.on).
+    SlabCompositing slabs = {};
+    const MarginalCdfTable* marginal = nullptr;
 };
 
 /// What one window's primitives draw, before the compositor's occlusion culling (integer sums:
@@ -69,6 +74,13 @@ struct ProjectionCounts {
 /// depth, its slab clamped to the batch's, and its member count; window.slabBase is the
 /// batch's first slab. @return what the primitives draw, by kind.
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window);
+
+/// @brief --compositing slabs: the slab fractions of a primitive at view position @p c, distance
+/// @p distance, in slab @p slab, whose kernel is @p ctx's (a sphere of h, or ctx.shape's ellipsoid)
+/// widened along the view ray by an aggregate's second moment @p depthSpread (world²): its
+/// profile along the ray is the kernel's marginal with the kernel unit a world units, a² =
+/// |Mᵀω|² + depthSpread / s_g² (ω = c/|c|; |Mᵀω| = h for a sphere), matching the variance.
+SlabProfile slabProfileFor(const glm::dvec3& c, double distance, int64_t slab, float depthSpread, const ProjectionContext& ctx);
 
 /// @brief Projects one voxel (view-space centre @p c, extinction per voxel length @p sigma).
 /// @param spreadPx2 a level-of-detail aggregate's projected second moment (px², added to

@@ -57,6 +57,8 @@ void RenderSettings::validate() const {
         throw Error("--subpixels: must be in [1, " + std::to_string(kMaxSubpixels) + "]");
     if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
         throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
+    if (!(slabThickness == 0.0 || (slabThickness >= 0.5 && slabThickness <= 1.0)))
+        throw Error("--slab-thickness: must be a number of voxels in [0.5, 1]");
     shading.validate();
     emission.validate();
     (void)KernelShape::named(kernel);  // throws "--kernel: unknown kernel ..."
@@ -92,6 +94,14 @@ FilterOrder parseFilterOrder(const std::string& name) {
 
 std::string toString(FilterOrder order) { return order == FilterOrder::Prefilter ? "prefilter" : "postfilter"; }
 
+CompositingOrder parseCompositingOrder(const std::string& name) {
+    if (name == "kernels") return CompositingOrder::Kernels;
+    if (name == "slabs") return CompositingOrder::Slabs;
+    throw Error("--compositing: expected 'kernels' or 'slabs', got '" + name + "'");
+}
+
+std::string toString(CompositingOrder order) { return order == CompositingOrder::Slabs ? "slabs" : "kernels"; }
+
 nlohmann::json RenderSettings::toJson() const {
     nlohmann::json j;
     j["mode"] = toString(mode);
@@ -121,6 +131,9 @@ nlohmann::json RenderSettings::toJson() const {
     j["show_primitives"] = showPrimitives;
     j["lod"] = mode == RenderMode::None ? 0.0 : lodPx;
     if (!lodBlend) j["lod_blend"] = false;  // absent when on: default outputs unchanged
+    if (compositing != CompositingOrder::Kernels && mode != RenderMode::Reference)
+        j["compositing"] = toString(compositing);  // absent for the default: default outputs unchanged
+    if (effectiveSlabThickness() != 1.0 && mode != RenderMode::Reference) j["slab_thickness"] = effectiveSlabThickness();
     j["simd"] = simd;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
     if (shading.active()) j["shading"] = shading.toJson();  // absent when off: unshaded outputs unchanged

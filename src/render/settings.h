@@ -8,6 +8,7 @@
 #include <string>
 
 #include "camera/camera.h"
+#include "composite/compositing.h"
 #include "util/error.h"
 #include "shading/shading.h"
 #include "volume/emission.h"
@@ -46,6 +47,10 @@ enum class FilterOrder { Prefilter, Postfilter };
 /// @throw Error "--filter-order: expected 'prefilter' or 'postfilter', got '<name>'".
 FilterOrder parseFilterOrder(const std::string& name);
 std::string toString(FilterOrder order);
+
+/// @throw Error "--compositing: expected 'kernels' or 'slabs', got '<name>'".
+CompositingOrder parseCompositingOrder(const std::string& name);
+std::string toString(CompositingOrder order);
 
 /// Postfilter: sub-pixels per axis by default and the most --subpixels accepts.
 /// k = 1 with a small V_s already reaches 45–60 dB on the tubes at the cost of the prefilter
@@ -100,6 +105,16 @@ struct RenderSettings {
     /// volume/stream.h kLodPassage); false: each block switches at once where a level becomes
     /// admissible (cheaper where blocks pass from voxels to 2³ cells; for still images).
     bool lodBlend = true;
+    /// Forward modes: each kernel composited whole at its depth (Kernels, DESIGN §4), or every
+    /// kernel's optical depth spread over the radial slabs it spans and each slab composited
+    /// once (Slabs; composite/compositing.h, docs/compositing.md). The reference ignores it.
+    CompositingOrder compositing = CompositingOrder::Kernels;
+    /// Depth slab thickness in voxels (--slab-thickness, [0.5, 1]); 0: automatic, 1 in the kernel
+    /// order and ½ in the slab order (docs/compositing.md: half-voxel slabs gain 2–17 dB there).
+    double slabThickness = 0.0;
+    double effectiveSlabThickness() const {
+        return slabThickness > 0.0 ? slabThickness : compositing == CompositingOrder::Slabs ? 0.5 : 1.0;
+    }
     /// Splats through the vector loop (Highway, polynomial footprint); false: the scalar table
     /// path it is tested against (same image to ~1e−6; for measuring).
     bool simd = true;

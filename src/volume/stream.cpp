@@ -31,6 +31,7 @@ void VoxelBatch::resize(size_t n) {
     sigma.resize(n);
     color.resize(n);
     spread.resize(n);
+    depthSpread.resize(n);
     members.resize(n);
 }
 
@@ -40,6 +41,7 @@ void VoxelBatch::clear() {
     sigma.clear();
     color.clear();
     spread.clear();
+    depthSpread.clear();
     members.clear();
 }
 
@@ -352,6 +354,7 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
         out.sigma.push_back(w == 1.f ? cls.sigma : cls.sigma * w);
         out.color.push_back(cls.color);
         out.spread.push_back(0.f);
+        out.depthSpread.push_back(0.f);
         out.members.push_back(c < 0.5f ? 1 : 0);
     });
 }
@@ -481,6 +484,10 @@ void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, c
                 // surface by a cell (docs/animation.md, session 5).
                 const double full = (double(side) * side - 1.0) / 12.0 * 0.5 * (glm::dot(ux, ux) + glm::dot(uy, uy));
                 out.spread.push_back(float(std::max(spread - full, 0.0)));
+                // Along the view ray the whole second moment counts (world²): the depth profile of the
+                // cell's mass (--compositing slabs, composite/slab_profile.h), ωᵀ A Σ Aᵀ ω.
+                const glm::dvec3 uz = (v / glm::length(v)) * toView;
+                out.depthSpread.push_back(float(std::max(glm::dot(uz, cov * uz), 0.0)));
                 out.members.push_back(counted ? a.n : 0);
                 if (counted) ++counts.aggregates, counts.aggregatedVoxels += a.n;
             }
@@ -501,6 +508,7 @@ void copyRecord(const VoxelBatch& src, size_t i, VoxelBatch& dst, size_t k) {
     dst.sigma[k] = src.sigma[i];
     dst.color[k] = src.color[i];
     dst.spread[k] = src.spread[i];
+    dst.depthSpread[k] = src.depthSpread[i];
     dst.members[k] = src.members[i];
 }
 }  // namespace

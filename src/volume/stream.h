@@ -48,6 +48,8 @@ struct VoxelBatch {
     Array<glm::vec3> color;    ///< emitted colour c_k (σ-weighted mean for an aggregate)
     Array<float> spread;       ///< aggregate: projected second moment about the centroid
                                ///< beyond a full cell's, isotropic (trace/2), px²; 0 for a voxel
+    Array<float> depthSpread;  ///< aggregate: σ-weighted variance of its voxel centres along the
+                               ///< view ray (world²), the whole second moment; 0 for a voxel
     Array<uint32_t> members;   ///< voxels the record stands for (1, or an aggregate's count;
                                ///< 0 for the lighter of a blended block's two levels)
     int64_t slabBegin = 0;           ///< first slab of the window: slab = floor(distance / (h·slabThickness))

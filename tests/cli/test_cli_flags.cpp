@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 /// The render flags every rendering command shares (render_flags.cpp declares them once).
 const std::vector<std::string> kShared{
     "--grid",    "--tf",        "--size",         "--up",          "--view-dir",  "--threshold", "--lod", "--lod-blend",
-    "--footprint", "--filter-order", "--subpixels", "--simd",      "--threads",   "--shading",
+    "--footprint", "--filter-order", "--subpixels", "--compositing", "--slab-thickness", "--simd", "--threads", "--shading",
     "--ambient", "--diffuse",   "--specular",     "--shininess",   "--light",     "--gradient-opacity",
     "--emission", "--emission-map", "--emission-scale", "--kelvin"};
 
@@ -172,6 +172,9 @@ TEST_F(CliFlags, SharedFlagsAreParsedAlike) {
         {"--filter-order sideways", "--filter-order"},
         {"--footprint fast", "--footprint"},
         {"--simd maybe", "--simd"},
+        {"--compositing sheets", "--compositing"},
+        {"--slab-thickness 0.25", "--slab-thickness"},
+        {"--slab-thickness x", "--slab-thickness"},
         {"--up 0,0", "--up"},
         {"--view-dir 1,x,0", "--view-dir"},
         {"--shading glossy", "--shading"},
