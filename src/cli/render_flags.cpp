@@ -78,15 +78,16 @@ constexpr RenderFlag kRenderFlags[] = {
      "postfilter: composite on K x K sub-pixels per pixel, 1..8 (default 1;\n"
      "2 is closer to the reference, at up to 3.5x the time at close views)"},
     {"--compositing", "C", kQuality,
-     "kernels (default): each splat composited whole at its centre's depth,\n"
-     "points summed per one-voxel slab; slabs: every kernel's optical depth\n"
-     "spread over the depth slabs it spans along the ray, each slab\n"
-     "composited once (closer to the reference where colour changes from\n"
-     "voxel to voxel, e.g. --shading; docs/compositing.md)"},
+     "auto (default): slabs with --shading phong, else kernels; kernels:\n"
+     "each splat composited whole at its centre's depth, points summed per\n"
+     "one-voxel slab; slabs: every kernel's optical depth spread over the\n"
+     "depth slabs it spans along the ray, each slab composited once (closer\n"
+     "to the reference where colour changes from voxel to voxel, as shading\n"
+     "makes it; ~1.45x the time at framed and close views; docs/compositing.md)"},
     {"--slab-thickness", "V", kQuality,
-     "depth slab thickness in voxels, 0.5..1 (default: 1 with --compositing\n"
-     "kernels, 0.5 with slabs): points are summed per slab, and --compositing\n"
-     "slabs composites once per slab"},
+     "depth slab thickness in voxels, 0.5..1 (default: 1 in the kernels\n"
+     "order, 0.5 in the slabs order): points are summed per slab, and the\n"
+     "slabs order composites once per slab"},
     {"--simd", "on|off", kQuality, "splats through the vector loop (default on) or the scalar table path"},
     {"--show-primitives", nullptr, kQuality, "tint splats red, points keep their colour"},
     {"--tables", "DIR", kQuality,

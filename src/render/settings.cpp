@@ -94,10 +94,11 @@ FilterOrder parseFilterOrder(const std::string& name) {
 
 std::string toString(FilterOrder order) { return order == FilterOrder::Prefilter ? "prefilter" : "postfilter"; }
 
-CompositingOrder parseCompositingOrder(const std::string& name) {
+std::optional<CompositingOrder> parseCompositingOrder(const std::string& name) {
+    if (name == "auto") return std::nullopt;
     if (name == "kernels") return CompositingOrder::Kernels;
     if (name == "slabs") return CompositingOrder::Slabs;
-    throw Error("--compositing: expected 'kernels' or 'slabs', got '" + name + "'");
+    throw Error("--compositing: expected 'auto', 'kernels' or 'slabs', got '" + name + "'");
 }
 
 std::string toString(CompositingOrder order) { return order == CompositingOrder::Slabs ? "slabs" : "kernels"; }
@@ -131,8 +132,8 @@ nlohmann::json RenderSettings::toJson() const {
     j["show_primitives"] = showPrimitives;
     j["lod"] = mode == RenderMode::None ? 0.0 : lodPx;
     if (!lodBlend) j["lod_blend"] = false;  // absent when on: default outputs unchanged
-    if (compositing != CompositingOrder::Kernels && mode != RenderMode::Reference)
-        j["compositing"] = toString(compositing);  // absent for the default: default outputs unchanged
+    if (effectiveCompositing() != CompositingOrder::Kernels && mode != RenderMode::Reference)
+        j["compositing"] = toString(effectiveCompositing());  // absent for kernels: unshaded outputs unchanged
     if (effectiveSlabThickness() != 1.0 && mode != RenderMode::Reference) j["slab_thickness"] = effectiveSlabThickness();
     j["simd"] = simd;
     j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)

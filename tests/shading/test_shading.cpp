@@ -262,10 +262,15 @@ TEST(ShadingRender, UnitFactorsGiveTheUnshadedImageBitForBit) {
     for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Splat, RenderMode::Point, RenderMode::Reference}) {
         RenderSettings off = settingsFor(mode, 1.0, ShadingSettings{});
         if (mode == RenderMode::Reference) off.camera.width = off.camera.height = 32, off.spp = 1;
-        RenderSettings unit = off;
-        unit.shading = phong(1.f, 0.f, 0.f);
-        const Image a = renderWith(v, tf, off), b = renderWith(v, tf, unit);
-        expectBitIdentical(a, b, toString(mode));
+        // In either compositing order (--compositing auto takes slabs for Phong, kernels unshaded).
+        for (const CompositingOrder order : {CompositingOrder::Kernels, CompositingOrder::Slabs}) {
+            RenderSettings offIn = off;
+            offIn.compositing = order;
+            RenderSettings unit = offIn;
+            unit.shading = phong(1.f, 0.f, 0.f);
+            expectBitIdentical(renderWith(v, tf, offIn), renderWith(v, tf, unit), toString(mode) + " " + toString(order));
+        }
+        const Image a = renderWith(v, tf, off);
         RenderSettings lit = off;
         lit.shading = ShadingSettings::ctPreset();
         const Image c = renderWith(v, tf, lit);
@@ -274,6 +279,27 @@ TEST(ShadingRender, UnitFactorsGiveTheUnshadedImageBitForBit) {
             largest = std::max(largest, double(glm::length(a.pixels[i] - c.pixels[i])));
         EXPECT_GT(largest, 0.05) << toString(mode) << ": shading changed nothing";
     }
+}
+
+// --compositing auto: the slab order where Phong shading lights one voxel layer and not the next,
+// the kernel order otherwise (unshaded, or only gradient opacity); an explicit order is kept.
+TEST(ShadingRender, AutoCompositingTakesSlabsForPhong) {
+    RenderSettings s;
+    EXPECT_FALSE(s.compositing.has_value());
+    EXPECT_EQ(s.effectiveCompositing(), CompositingOrder::Kernels);
+    EXPECT_EQ(s.effectiveSlabThickness(), 1.0);
+    s.shading.gradientOpacity = 0.5f;
+    EXPECT_EQ(s.effectiveCompositing(), CompositingOrder::Kernels);
+    s.shading = ShadingSettings::ctPreset();
+    EXPECT_EQ(s.effectiveCompositing(), CompositingOrder::Slabs);
+    EXPECT_EQ(s.effectiveSlabThickness(), 0.5);
+    EXPECT_EQ(s.toJson().at("compositing"), "slabs");
+    s.compositing = CompositingOrder::Kernels;
+    EXPECT_EQ(s.effectiveCompositing(), CompositingOrder::Kernels);
+    EXPECT_FALSE(s.toJson().contains("compositing"));
+    EXPECT_FALSE(parseCompositingOrder("auto").has_value());
+    EXPECT_EQ(parseCompositingOrder("slabs"), CompositingOrder::Slabs);
+    EXPECT_THROW(parseCompositingOrder("sheets"), Error);
 }
 
 // Active tiles are shaded like the same voxels stored in leaves (the pass voxelizes them).
