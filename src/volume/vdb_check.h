@@ -29,8 +29,11 @@ void checkVdbStructure(const std::string& path);
 /// (Transform::write: type name, then the map); 0 for other maps (a frustum: variable).
 uint64_t vdbMapBytes(const std::string& mapType);
 
-/// @brief Checks that @p path exists and is a regular file, runs checkVdbStructure, then
-/// opens @p file without delayed loading (so a truncated file fails here, not mid-render).
+/// @brief Checks that @p path exists and is a regular file, then runs checkVdbStructure.
+/// @throw Error naming @p path: no such file, not a regular file, not a VDB, truncated.
+void checkVdbFile(const std::string& path);
+
+/// @brief checkVdbFile, then opens @p file without delayed loading (so a truncated file fails here, not mid-render).
 /// @throw Error naming @p path: no such file, not a regular file, not a VDB, truncated.
 void openVdbFile(openvdb::io::File& file, const std::string& path);
 

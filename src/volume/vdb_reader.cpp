@@ -1,0 +1,625 @@
+// volume/vdb_reader.cpp — reading a .vdb grid in process (see vdb_reader.h).
+// The layout, as OpenVDB 10 writes and reads it (io/Archive.cc, io/GridDescriptor.cc,
+// tree/RootNode.h, InternalNode.h, LeafNode.h readTopology/readBuffers, io/Compression.h
+// readCompressedValues), all little-endian:
+//   file: int64 magic, uint32 file version, uint32 library major, minor, char hasGridOffsets,
+//     36-char UUID, metadata, int32 grid count, per grid a descriptor: name, type (suffix
+//     "_HalfFloat": values stored as half), instance parent (strings: uint32 length + bytes),
+//     int64 gridPos, blockPos, endPos.
+//   grid at gridPos: uint32 compression flags, metadata, map type name + map, then the
+//     topology: int32 buffer count (1), root background, uint32 tile and child counts, tiles
+//     (int32[3] origin, value, bool active), children (int32[3] origin, upper node); an
+//     internal node is child mask, value mask, its NUM_VALUES tile values (compressed, below),
+//     then its children in mask order; a leaf is its value mask. From blockPos, the leaves'
+//     buffers in the same order: value mask again (io::File seeks over it: the topology's
+//     counts), then 512 values (compressed).
+//   compressed values: int8 mode (NO_MASK_OR_INACTIVE_VALS … NO_MASK_AND_ALL_VALS), up to two
+//     inactive values (full value type), a selection mask (modes 3-5), then a chunk of the
+//     active values only (mask compression on, mode not 6) or of all; a chunk is int64 n and
+//     n compressed bytes (blosc or zlib), or -n and n raw bytes; uncompressed grids: raw.
+#include "volume/vdb_reader.h"
+
+#include <openvdb/io/Compression.h>
+#include <openvdb/math/Maps.h>
+
+#include <blosc.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <istream>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <streambuf>
+#include <vector>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "util/error.h"
+#include "volume/grid.h"
+#include "volume/vdb_check.h"
+
+namespace vdbsplat {
+
+namespace {
+
+using FloatTree = openvdb::FloatTree;
+using Root = FloatTree::RootNodeType;
+using Upper = Root::ChildNodeType;
+using Lower = Upper::ChildNodeType;
+using Leaf = Lower::ChildNodeType;
+using openvdb::Coord;
+
+constexpr int64_t kVdbMagic = 0x56444220;
+constexpr uint32_t kFirstVersion = 222;  ///< OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION: the layout read here
+constexpr uint32_t kLastVersion = openvdb::OPENVDB_FILE_VERSION;
+constexpr uint64_t kMaxStringBytes = 1 << 16;  ///< longer grid names or type names are left to OpenVDB
+constexpr uint64_t kLeafGrain = 64;            ///< leaves per parallel task
+
+/// Thrown where this reader leaves the file to OpenVDB.
+struct Unsupported {
+    const char* why;
+};
+
+/// The file's bytes and its name for messages.
+struct Image {
+    const char* data;
+    uint64_t size;
+    const std::string& label;
+};
+
+/// Bounds-checked reads from [pos, end) of an Image.
+class Cursor {
+public:
+    Cursor(const Image& f, uint64_t pos, uint64_t end) : f_(&f), pos_(pos), end_(std::min(end, f.size)) {
+        if (pos_ > end_) corrupt("section offset");
+    }
+    const char* take(uint64_t n, const char* what) {
+        if (n > end_ - pos_) corrupt(what);
+        const char* p = f_->data + pos_;
+        pos_ += n;
+        return p;
+    }
+    template <typename T>
+    T get(const char* what) {
+        T v;
+        std::memcpy(&v, take(sizeof(T), what), sizeof(T));
+        return v;
+    }
+    /// A string (uint32 length + bytes); longer than kMaxStringBytes: Unsupported.
+    std::string string(const char* what) {
+        const uint32_t n = get<uint32_t>(what);
+        if (n > kMaxStringBytes) throw Unsupported{"a long name string"};
+        const char* p = take(n, what);
+        return std::string(p, n);
+    }
+    void seek(uint64_t to, const char* what) {
+        if (to < pos_ || to > end_) corrupt(what);
+        pos_ = to;
+    }
+    uint64_t pos() const { return pos_; }
+    uint64_t left() const { return end_ - pos_; }
+    [[noreturn]] void corrupt(const std::string& what) const {
+        throw Error(f_->label + ": truncated or corrupt VDB file (" + what + " at byte " + std::to_string(pos_) +
+                    " of " + std::to_string(f_->size) + ")");
+    }
+
+private:
+    const Image* f_;
+    uint64_t pos_, end_;
+};
+
+/// A read-only std::istream over bytes in memory (for OpenVDB's metadata and map readers).
+class MemoryStream : private std::streambuf, public std::istream {
+public:
+    MemoryStream(const char* data, uint64_t size) : std::istream(static_cast<std::streambuf*>(this)) {
+        char* p = const_cast<char*>(data);  // never written: a get area only
+        setg(p, p, p + size);
+    }
+};
+
+// ---- file header, metadata, descriptors ----------------------------------------------------
+
+/// Walks a metadata block as OpenVDB's MetaMap::readMeta reads it (a registered fixed-size
+/// type reads its own size: it must declare that size, as checkVdbStructure requires).
+void skipMetadata(Cursor& c) {
+    const int32_t count = c.get<int32_t>("metadata count");
+    if (count < 0 || uint64_t(count) > c.left() / 12) c.corrupt("metadata count");
+    for (int32_t i = 0; i < count; ++i) {
+        c.take(c.get<uint32_t>("metadata name"), "metadata name");
+        const std::string type = c.string("metadata type");
+        const uint32_t declared = c.get<uint32_t>("metadata value size");
+        if (type != "string" && openvdb::Metadata::isRegisteredType(type)) {
+            uint32_t fixed = 0;
+            try {
+                fixed = openvdb::Metadata::createMetadata(type)->size();
+            } catch (const std::exception&) {
+                throw Unsupported{"a metadata type without a size"};
+            }
+            if (fixed != declared) c.corrupt("metadata value size");
+        }
+        c.take(declared, "metadata value");
+    }
+}
+
+struct Descriptor {
+    std::string name, type;  ///< type without "_HalfFloat"
+    bool half = false;
+    int64_t gridPos = 0, blockPos = 0, endPos = 0;
+};
+
+/// Header, file metadata and grid descriptors; Unsupported for layouts left to OpenVDB.
+std::vector<Descriptor> readDescriptors(const Image& f) {
+    Cursor c(f, 0, f.size);
+    if (c.get<int64_t>("magic number") != kVdbMagic) throw Unsupported{"not a VDB file"};
+    const uint32_t version = c.get<uint32_t>("file version");
+    if (version < kFirstVersion || version > kLastVersion) throw Unsupported{"a file version before 222 or after 224"};
+    c.get<uint32_t>("library major version");
+    c.get<uint32_t>("library minor version");
+    if (!c.get<char>("grid offsets flag")) throw Unsupported{"a file without grid offsets (io::Stream)"};
+    c.take(36, "file UUID");
+    skipMetadata(c);
+    const int32_t count = c.get<int32_t>("grid count");
+    if (count < 0 || uint64_t(count) > c.left() / 36) c.corrupt("grid count");
+    std::vector<Descriptor> out(static_cast<size_t>(count));
+    for (Descriptor& d : out) {
+        d.name = c.string("grid name");
+        d.type = c.string("grid type");
+        if (!c.string("grid instance parent").empty()) throw Unsupported{"an instanced grid"};
+        d.gridPos = c.get<int64_t>("grid offset");
+        d.blockPos = c.get<int64_t>("grid data offset");
+        d.endPos = c.get<int64_t>("grid end offset");
+        if (d.gridPos < int64_t(c.pos()) || d.blockPos < d.gridPos || d.endPos < d.blockPos ||
+            uint64_t(d.endPos) > f.size)
+            c.corrupt("grid extends past the end of the file");
+        // Names made unique by OpenVDB (a suffix after \x1e) or empty: its lookup rules apply.
+        if (d.name.empty() || d.name.find('\x1e') != std::string::npos) throw Unsupported{"a suffixed grid name"};
+        static const std::string kHalf = "_HalfFloat";
+        if (d.type.size() > kHalf.size() && d.type.compare(d.type.size() - kHalf.size(), kHalf.size(), kHalf) == 0) {
+            d.type.resize(d.type.size() - kHalf.size());
+            d.half = true;
+        }
+        if (!openvdb::GridBase::isRegistered(d.type)) throw Unsupported{"an unregistered grid type"};
+        c.seek(uint64_t(d.endPos), "grid end offset");  // OpenVDB reads the next descriptor there
+    }
+    return out;
+}
+
+bool isFloat(const std::string& type) { return type == FloatTree::treeType(); }
+bool isDouble(const std::string& type) { return type == openvdb::DoubleTree::treeType(); }
+
+/// The descriptor loadVolume reads (readGridToRender's choice); Unsupported when there is none
+/// (OpenVDB's path words that error).
+const Descriptor& chooseGrid(const std::vector<Descriptor>& all, const std::string& gridName) {
+    std::vector<std::string> names;
+    std::vector<bool> scalar;
+    for (const Descriptor& d : all) names.push_back(d.name), scalar.push_back(isFloat(d.type) || isDouble(d.type));
+    size_t k = gridName.empty() ? defaultGridIndex(names, scalar) : size_t(std::find(names.begin(), names.end(), gridName) - names.begin());
+    if (k >= all.size() || !scalar[k]) throw Unsupported{"no such float or double grid"};
+    return all[k];
+}
+
+// ---- compressed values ---------------------------------------------------------------------
+
+/// How a grid's values are stored, and its background, as readCompressedValues needs them.
+template <typename V>
+struct Codec {
+    uint32_t compression = 0;  ///< io::COMPRESS_ZIP | COMPRESS_ACTIVE_MASK | COMPRESS_BLOSC
+    bool half = false;         ///< values stored as 16-bit floats
+    V background{};
+};
+
+/// Checks a blosc chunk's header against its @p n bytes and the @p bytes it must hold.
+void checkBlosc(Cursor& c, const char* src, uint64_t n, uint64_t bytes) {
+    size_t nbytes = 0, cbytes = 0, block = 0;
+    if (n < BLOSC_MIN_HEADER_LENGTH || blosc_cbuffer_validate(src, size_t(n), &nbytes) != 0)
+        c.corrupt("invalid blosc chunk");
+    blosc_cbuffer_sizes(src, &nbytes, &cbytes, &block);
+    if (nbytes != bytes || cbytes != n)
+        c.corrupt("blosc chunk of " + std::to_string(n) + " bytes whose header says " + std::to_string(cbytes) +
+                  " bytes holding " + std::to_string(nbytes) + ", not " + std::to_string(bytes));
+}
+
+void decodeBlosc(Cursor& c, const char* src, char* dest, uint64_t bytes) {
+    if (bytes > 0 && blosc_decompress_ctx(src, dest, bytes, /*numinternalthreads=*/1) != int(bytes))
+        c.corrupt("blosc chunk that does not decompress");
+}
+
+void decodeZlib(Cursor& c, const char* src, uint64_t n, char* dest, uint64_t bytes) {
+    char unused;
+    uLongf out = uLongf(bytes);
+    const int status = uncompress(reinterpret_cast<Bytef*>(bytes ? dest : &unused), &out,
+                                  reinterpret_cast<const Bytef*>(src), uLong(n));
+    if (status != Z_OK || out != bytes)
+        c.corrupt("zlib chunk that does not inflate to " + std::to_string(bytes) + " bytes");
+}
+
+/// One chunk of @p bytes bytes (after decompression) into @p dest, or skipped when it is null.
+void readChunk(Cursor& c, char* dest, uint64_t bytes, uint32_t compression) {
+    const bool blosc = compression & openvdb::io::COMPRESS_BLOSC;
+    if (!blosc && !(compression & openvdb::io::COMPRESS_ZIP)) {
+        const char* src = c.take(bytes, "uncompressed values");
+        if (dest) std::memcpy(dest, src, bytes);
+        return;
+    }
+    const int64_t n = c.get<int64_t>(blosc ? "blosc chunk size" : "zlib chunk size");
+    if (n <= 0) {  // stored raw
+        if (uint64_t(0) - uint64_t(n) != bytes) c.corrupt("raw chunk size");
+        const char* src = c.take(bytes, "raw chunk");
+        if (dest) std::memcpy(dest, src, bytes);
+        return;
+    }
+    const char* src = c.take(uint64_t(n), blosc ? "blosc chunk" : "zlib chunk");
+    if (blosc) checkBlosc(c, src, uint64_t(n), bytes);  // while skipping too: errors are found in file order
+    if (!dest) return;
+    if (blosc)
+        decodeBlosc(c, src, dest, bytes);
+    else
+        decodeZlib(c, src, uint64_t(n), dest, bytes);
+}
+
+/// Scratch arrays for one thread's reads (mask-compressed values, half floats).
+template <typename V>
+struct Scratch {
+    std::vector<V> values;
+    std::vector<uint16_t> halves;
+};
+
+/// @p count stored values into @p out (skipped when null), widening half floats.
+template <typename V>
+void readStored(Cursor& c, V* out, uint32_t count, const Codec<V>& codec, Scratch<V>& s) {
+    if (!codec.half) {
+        readChunk(c, reinterpret_cast<char*>(out), uint64_t(count) * sizeof(V), codec.compression);
+        return;
+    }
+    if (count == 0) return;  // OpenVDB's HalfReader reads nothing then, not even a chunk header
+    if (!out) return readChunk(c, nullptr, uint64_t(count) * 2, codec.compression);
+    s.halves.resize(count);
+    readChunk(c, reinterpret_cast<char*>(s.halves.data()), uint64_t(count) * 2, codec.compression);
+    for (uint32_t i = 0; i < count; ++i) {
+        openvdb::math::half h;
+        h.setBits(s.halves[i]);
+        out[i] = V(float(h));
+    }
+}
+
+/// A node's values as readCompressedValues reads them: all MaskT::SIZE of them into @p out,
+/// inactive ones rebuilt from the mode byte; @p out null: only walked over (bounds checked).
+template <typename V, typename MaskT>
+void readValues(Cursor& c, V* out, const MaskT& valueMask, const Codec<V>& codec, Scratch<V>& s) {
+    constexpr uint32_t kSize = MaskT::SIZE;
+    const int8_t mode = c.get<int8_t>("node compression mode");
+    if (mode < openvdb::io::NO_MASK_OR_INACTIVE_VALS || mode > openvdb::io::NO_MASK_AND_ALL_VALS)
+        throw Unsupported{"an unknown node compression mode"};
+    V inactive0 = mode == openvdb::io::NO_MASK_OR_INACTIVE_VALS ? codec.background : V(-codec.background);
+    V inactive1 = codec.background;
+    if (mode == openvdb::io::NO_MASK_AND_ONE_INACTIVE_VAL || mode == openvdb::io::MASK_AND_ONE_INACTIVE_VAL ||
+        mode == openvdb::io::MASK_AND_TWO_INACTIVE_VALS) {
+        inactive0 = c.get<V>("inactive value");
+        if (mode == openvdb::io::MASK_AND_TWO_INACTIVE_VALS) inactive1 = c.get<V>("inactive value");
+    }
+    MaskT selection;
+    if (mode == openvdb::io::MASK_AND_NO_INACTIVE_VALS || mode == openvdb::io::MASK_AND_ONE_INACTIVE_VAL ||
+        mode == openvdb::io::MASK_AND_TWO_INACTIVE_VALS)
+        std::memcpy(&selection.template getWord<typename MaskT::Word>(0), c.take(MaskT::memUsage(), "selection mask"),
+                    MaskT::memUsage());
+    uint32_t count = kSize;
+    if ((codec.compression & openvdb::io::COMPRESS_ACTIVE_MASK) && mode != openvdb::io::NO_MASK_AND_ALL_VALS)
+        count = valueMask.countOn();
+    if (!out || count == kSize) return readStored(c, out, count, codec, s);
+    s.values.resize(count);
+    readStored(c, s.values.data(), count, codec, s);
+    for (uint32_t i = 0, k = 0; i < kSize; ++i)
+        out[i] = valueMask.isOn(i) ? s.values[k++] : selection.isOn(i) ? inactive1 : inactive0;
+}
+
+template <typename MaskT>
+MaskT loadMask(Cursor& c, const char* what) {
+    MaskT m;
+    std::memcpy(&m.template getWord<typename MaskT::Word>(0), c.take(MaskT::memUsage(), what), MaskT::memUsage());
+    return m;
+}
+
+// ---- the tree ------------------------------------------------------------------------------
+
+/// Finite active value range and non-finite count, merged across threads (order-free).
+struct Stats {
+    float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
+    uint64_t nonFinite = 0;
+    void merge(const Stats& o) {
+        lo = std::min(lo, o.lo);
+        hi = std::max(hi, o.hi);
+        nonFinite += o.nonFinite;
+    }
+    /// An active value of @p voxels voxels: 0 when it is not finite (counted), else measured.
+    float active(float x, uint64_t voxels) {
+        if (!std::isfinite(x)) {
+            nonFinite += voxels;
+            return 0.0f;
+        }
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+        return x;
+    }
+};
+
+/// A leaf of the tree (its buffer not yet allocated), to read from [begin, end) of the buffers.
+struct LeafJob {
+    Leaf* leaf;
+    uint64_t begin = 0, end = 0;
+};
+
+/// The error of the first damaged leaf in file order, whichever thread finds it.
+class FirstError {
+public:
+    void add(size_t index, const std::string& message) {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (index < index_) index_ = index, message_ = message;
+    }
+    void throwIfAny() const {
+        if (index_ != std::numeric_limits<size_t>::max()) throw Error(message_);
+    }
+
+private:
+    std::mutex mutex_;
+    size_t index_ = std::numeric_limits<size_t>::max();
+    std::string message_;
+};
+
+bool sameBits(float a, float b) { return std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b); }
+
+template <typename V>
+class TreeReader {
+public:
+    TreeReader(const Image& f, const Codec<V>& codec) : f_(f), codec_(codec), bg_(float(codec.background)) {}
+
+    /// The topology in [pos, end): the tree, with every leaf recorded (not yet read).
+    std::shared_ptr<FloatTree> readTopology(Cursor& c) {
+        auto tree = std::make_shared<FloatTree>(bg_);
+        const uint32_t tiles = c.get<uint32_t>("root tile count"), children = c.get<uint32_t>("root child count");
+        if (uint64_t(tiles) * (13 + sizeof(V)) + uint64_t(children) * (12 + 2 * Upper::NodeMaskType::memUsage()) >
+            c.left())
+            c.corrupt("root node tile or child count");
+        for (uint32_t n = 0; n < tiles; ++n) {
+            const Coord xyz = coord(c, "root tile");
+            const V value = c.get<V>("root tile value");
+            const uint8_t active = c.get<uint8_t>("root tile state");
+            if (active > 1) throw Unsupported{"a root tile state other than 0 or 1"};
+            tree->root().addTile(xyz, float(value), active != 0);  // measured below, once the table is final
+        }
+        Coord previous;
+        for (uint32_t n = 0; n < children; ++n) {
+            const Coord xyz = coord(c, "root child");
+            if (n > 0 && !(previous < xyz)) throw Unsupported{"root children out of order"};
+            previous = xyz;
+            auto upper = std::make_unique<Upper>(xyz, bg_);
+            readInternal(c, *upper);
+            tree->root().addChild(upper.release());
+        }
+        measureRootTiles(tree->root());
+        return tree;
+    }
+
+    /// Walks the buffers section [pos, end) (bounds and chunk headers, in file order).
+    void locateLeaves(Cursor& c) {
+        Scratch<V> none;
+        for (LeafJob& job : leaves_) {
+            c.take(Leaf::NodeMaskType::memUsage(), "leaf value mask");
+            job.begin = c.pos();
+            readValues<V>(c, nullptr, job.leaf->getValueMask(), codec_, none);
+            job.end = c.pos();
+        }
+    }
+
+    /// Reads every leaf's values (in parallel), then puts the leaves in the tree.
+    Stats readLeaves() {
+        const Stats leafStats = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, leaves_.size(), kLeafGrain), Stats{},
+            [&](const tbb::blocked_range<size_t>& r, Stats s) {
+                Scratch<V> scratch;
+                for (size_t i = r.begin(); i != r.end(); ++i) readLeaf(i, scratch, s);
+                return s;
+            },
+            [](Stats a, const Stats& b) {
+                a.merge(b);
+                return a;
+            });
+        errors_.throwIfAny();
+        Stats all = stats_;
+        all.merge(leafStats);
+        return all;
+    }
+
+private:
+    Coord coord(Cursor& c, const char* what) {
+        int32_t v[3];
+        std::memcpy(v, c.take(12, what), 12);
+        const Coord xyz(v[0], v[1], v[2]);
+        if ((xyz & ~(Upper::DIM - 1)) != xyz) throw Unsupported{"a root entry off the 4096 grid"};
+        return xyz;
+    }
+
+    /// An internal node's masks, tile values and children (OpenVDB's readTopology).
+    template <typename NodeT>
+    void readInternal(Cursor& c, NodeT& node) {
+        using Mask = typename NodeT::NodeMaskType;
+        const Mask childMask = loadMask<Mask>(c, "child mask"), valueMask = loadMask<Mask>(c, "value mask");
+        if (!(childMask & valueMask).isOff()) throw Unsupported{"an active tile under a child node"};
+        tiles_.resize(NodeT::NUM_VALUES);
+        readValues<V>(c, tiles_.data(), valueMask, codec_, scratch_);
+        const uint64_t voxels = uint64_t(NodeT::ChildNodeType::DIM) * NodeT::ChildNodeType::DIM * NodeT::ChildNodeType::DIM;
+        for (openvdb::Index i = 0; i < NodeT::NUM_VALUES; ++i) {
+            if (childMask.isOn(i)) continue;
+            const bool on = valueMask.isOn(i);
+            float v = float(tiles_[i]);
+            if (on) v = stats_.active(v, voxels);
+            if (on || !sameBits(v, bg_)) node.addTile(i, v, on);
+        }
+        for (auto it = childMask.beginOn(); it; ++it) {
+            const Coord origin = node.offsetToGlobalCoord(it.pos());
+            if constexpr (std::is_same_v<NodeT, Upper>) {
+                auto lower = std::make_unique<Lower>(origin, bg_);
+                readInternal(c, *lower);
+                node.addChild(lower.release());
+            } else {
+                auto leaf = std::make_unique<Leaf>(openvdb::PartialCreate(), origin, bg_);  // no buffer yet
+                leaf->setValueMask(loadMask<Leaf::NodeMaskType>(c, "leaf value mask"));
+                leaves_.push_back(LeafJob{leaf.get()});
+                node.addChild(leaf.release());
+            }
+        }
+    }
+
+    void measureRootTiles(Root& root) {
+        constexpr uint64_t voxels = uint64_t(Upper::DIM) * Upper::DIM * Upper::DIM;
+        for (auto it = root.beginValueOn(); it; ++it) it.setValue(stats_.active(*it, voxels));
+    }
+
+    void readLeaf(size_t index, Scratch<V>& scratch, Stats& s) {
+        const LeafJob& job = leaves_[index];
+        try {
+            const Leaf::NodeMaskType& mask = job.leaf->getValueMask();
+            job.leaf->allocate();
+            float* out = job.leaf->buffer().data();
+            Cursor c(f_, job.begin, job.end);
+            if constexpr (std::is_same_v<V, float>) {
+                readValues<V>(c, out, mask, codec_, scratch);
+            } else {
+                V wide[Leaf::SIZE];
+                readValues<V>(c, wide, mask, codec_, scratch);
+                for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) out[i] = float(wide[i]);
+            }
+            for (auto it = mask.beginOn(); it; ++it) out[it.pos()] = s.active(out[it.pos()], 1);
+        } catch (const Error& e) {
+            errors_.add(index, e.what());
+        } catch (const std::bad_alloc&) {
+            errors_.add(index, f_.label + ": out of memory reading the grid");
+        }
+    }
+
+    const Image& f_;
+    Codec<V> codec_;
+    float bg_;
+    std::vector<LeafJob> leaves_;
+    std::vector<V> tiles_;
+    Scratch<V> scratch_;
+    Stats stats_;
+    FirstError errors_;
+};
+
+/// The map OpenVDB's Transform::read makes of @p bytes (a linear map of a type vdbMapBytes knows).
+openvdb::math::Transform::Ptr readTransform(Cursor& c) {
+    const std::string type = c.string("grid transform type");
+    const uint64_t bytes = vdbMapBytes(type);
+    if (bytes == 0 || !openvdb::math::MapRegistry::isRegistered(type)) throw Unsupported{"a map type not read here"};
+    const char* data = c.take(bytes, "grid transform");
+    openvdb::math::MapBase::Ptr map = openvdb::math::MapRegistry::createMap(type);
+    MemoryStream in(data, bytes);
+    map->read(in);
+    if (!in) c.corrupt("grid transform");
+    return std::make_shared<openvdb::math::Transform>(map);
+}
+
+template <typename V>
+ReadGrid readGrid(const Image& f, const Descriptor& d) {
+    Cursor head(f, uint64_t(d.gridPos), uint64_t(d.blockPos));
+    Codec<V> codec;
+    codec.compression = head.get<uint32_t>("grid compression flags");
+    codec.half = d.half;
+    const uint64_t metaBegin = head.pos();
+    skipMetadata(head);
+    const uint64_t metaEnd = head.pos();
+    const openvdb::math::Transform::Ptr transform = readTransform(head);
+    if (head.get<int32_t>("tree buffer count") != 1) throw Unsupported{"a tree buffer count other than 1"};
+    codec.background = head.get<V>("root background value");
+    TreeReader<V> reader(f, codec);
+    std::shared_ptr<FloatTree> tree = reader.readTopology(head);
+    if (head.pos() != uint64_t(d.blockPos)) throw Unsupported{"topology that does not end at the grid's data offset"};
+    Cursor buffers(f, uint64_t(d.blockPos), uint64_t(d.endPos));
+    reader.locateLeaves(buffers);
+    const Stats stats = reader.readLeaves();
+
+    ReadGrid out;
+    out.grid = openvdb::FloatGrid::create(tree);
+    out.grid->setTransform(transform);
+    MemoryStream meta(f.data + metaBegin, metaEnd - metaBegin);
+    try {
+        out.grid->readMeta(meta);
+    } catch (const std::exception& e) {
+        head.corrupt("grid metadata (" + std::string(e.what()) + ")");
+    }
+    out.grid->removeMeta(openvdb::GridBase::META_FILE_DELAYED_LOAD);  // as io::File drops it
+    out.activeVoxels = out.grid->activeVoxelCount();
+    out.nonFiniteCount = stats.nonFinite;
+    out.valueMin = stats.lo <= stats.hi ? stats.lo : 0.0f;
+    out.valueMax = stats.lo <= stats.hi ? stats.hi : 0.0f;
+    return out;
+}
+
+/// The file mapped read-only (pages populated up front: one pass instead of a fault per page).
+class MappedFile {
+public:
+    explicit MappedFile(const std::string& path) {
+        const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd < 0) throw Error(path + ": cannot open for reading (" + std::strerror(errno) + ")");
+        struct stat st {};
+        if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+            ::close(fd);
+            throw Error(path + ": not a regular file");
+        }
+        size_ = uint64_t(st.st_size);
+        if (size_ > 0) {
+            void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+            if (p == MAP_FAILED) {
+                ::close(fd);
+                throw Error(path + ": cannot map for reading (" + std::strerror(errno) + ")");
+            }
+            data_ = static_cast<const char*>(p);
+        }
+        ::close(fd);
+    }
+    ~MappedFile() {
+        if (data_) ::munmap(const_cast<char*>(data_), size_);
+    }
+    MappedFile(const MappedFile&) = delete;
+    MappedFile& operator=(const MappedFile&) = delete;
+    const char* data() const { return data_; }
+    uint64_t size() const { return size_; }
+
+private:
+    const char* data_ = nullptr;
+    uint64_t size_ = 0;
+};
+
+}  // namespace
+
+std::optional<ReadGrid> readVdbGrid(const char* data, uint64_t size, const std::string& label,
+                                    const std::string& gridName, std::string* unsupported) {
+    initOpenVdb();  // the metadata, map and grid type registries
+    const Image f{data, size, label};
+    try {
+        const std::vector<Descriptor> all = readDescriptors(f);
+        const Descriptor& d = chooseGrid(all, gridName);
+        return isFloat(d.type) ? readGrid<float>(f, d) : readGrid<double>(f, d);
+    } catch (const Unsupported& u) {
+        if (unsupported) *unsupported = u.why;
+        return std::nullopt;
+    } catch (const std::bad_alloc&) {
+        throw Error(label + ": out of memory reading the grid");
+    }
+}
+
+std::optional<ReadGrid> readVdbGrid(const std::string& path, const std::string& gridName, std::string* unsupported) {
+    const MappedFile file(path);
+    return readVdbGrid(file.data(), file.size(), path, gridName, unsupported);
+}
+
+}  // namespace vdbsplat
