@@ -20,6 +20,7 @@
 #include "volume/vdb_reader.h"
 
 #include <openvdb/io/Compression.h>
+#include <openvdb/io/io.h>
 #include <openvdb/math/Maps.h>
 
 #include <blosc.h>
@@ -233,13 +234,16 @@ void decodeBlosc(Cursor& c, const char* src, char* dest, uint64_t bytes) {
         c.corrupt("blosc chunk that does not decompress");
 }
 
+/// Inflates exactly @p n bytes into exactly @p bytes bytes (OpenVDB writes one zlib stream per chunk).
 void decodeZlib(Cursor& c, const char* src, uint64_t n, char* dest, uint64_t bytes) {
     char unused;
     uLongf out = uLongf(bytes);
-    const int status = uncompress(reinterpret_cast<Bytef*>(bytes ? dest : &unused), &out,
-                                  reinterpret_cast<const Bytef*>(src), uLong(n));
-    if (status != Z_OK || out != bytes)
-        c.corrupt("zlib chunk that does not inflate to " + std::to_string(bytes) + " bytes");
+    uLong in = uLong(n);
+    const int status = uncompress2(reinterpret_cast<Bytef*>(bytes ? dest : &unused), &out,
+                                   reinterpret_cast<const Bytef*>(src), &in);
+    if (status != Z_OK || out != bytes || in != n)
+        c.corrupt("zlib chunk of " + std::to_string(n) + " bytes that does not inflate to exactly " +
+                  std::to_string(bytes) + " bytes");
 }
 
 /// One chunk of @p bytes bytes (after decompression) into @p dest, or skipped when it is null.
@@ -515,17 +519,26 @@ private:
     FirstError errors_;
 };
 
-/// The map OpenVDB's Transform::read makes of @p bytes (a linear map of a type vdbMapBytes knows).
+/// The transform OpenVDB's Transform::read makes (a linear map of a type vdbMapBytes knows),
+/// read by that function from exactly the bytes of its type name and map: no simplification,
+/// the map type kept, a singular map left for loadVolume's check to name.
 openvdb::math::Transform::Ptr readTransform(Cursor& c) {
+    const uint64_t begin = c.pos();
     const std::string type = c.string("grid transform type");
     const uint64_t bytes = vdbMapBytes(type);
     if (bytes == 0 || !openvdb::math::MapRegistry::isRegistered(type)) throw Unsupported{"a map type not read here"};
-    const char* data = c.take(bytes, "grid transform");
-    openvdb::math::MapBase::Ptr map = openvdb::math::MapRegistry::createMap(type);
-    MemoryStream in(data, bytes);
-    map->read(in);
+    const char* map = c.take(bytes, "grid transform");
+    const char* start = map - (c.pos() - bytes - begin);
+    MemoryStream in(start, c.pos() - begin);
+    openvdb::io::setCurrentVersion(in);  // the map layout of file versions 219 and later
+    openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform();
+    try {
+        transform->read(in);
+    } catch (const std::exception& e) {
+        c.corrupt("grid transform (" + std::string(e.what()) + ")");
+    }
     if (!in) c.corrupt("grid transform");
-    return std::make_shared<openvdb::math::Transform>(map);
+    return transform;
 }
 
 template <typename V>
