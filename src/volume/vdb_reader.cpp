@@ -295,6 +295,28 @@ void readStored(Cursor& c, V* out, uint32_t count, const Codec<V>& codec, Scratc
     }
 }
 
+/// Spreads the active values @p active over @p out (in mask order); inactive ones are
+/// @p inactive1 where @p selection is on, else @p inactive0 (readCompressedValues' rule).
+/// Word by word and without branches per voxel: sparse leaves' masks are unpredictable.
+template <typename V, typename MaskT>
+void expandActive(V* out, const V* active, const MaskT& valueMask, const MaskT& selection, V inactive0, V inactive1) {
+    using Word = typename MaskT::Word;
+    for (uint32_t w = 0, k = 0; w < MaskT::WORD_COUNT; ++w, out += 64) {
+        const Word on = valueMask.template getWord<Word>(w), sel = selection.template getWord<Word>(w);
+        if (on == ~Word(0)) {
+            std::memcpy(out, active + k, 64 * sizeof(V));
+            k += 64;
+            continue;
+        }
+        for (uint32_t b = 0; b < 64; ++b) {
+            const bool isOn = (on >> b) & 1;
+            const V inactive = (sel >> b) & 1 ? inactive1 : inactive0;
+            out[b] = isOn ? active[k] : inactive;
+            k += isOn;
+        }
+    }
+}
+
 /// A node's values as readCompressedValues reads them: all MaskT::SIZE of them into @p out,
 /// inactive ones rebuilt from the mode byte; @p out null: only walked over (bounds checked).
 template <typename V, typename MaskT>
@@ -319,10 +341,9 @@ void readValues(Cursor& c, V* out, const MaskT& valueMask, const Codec<V>& codec
     if ((codec.compression & openvdb::io::COMPRESS_ACTIVE_MASK) && mode != openvdb::io::NO_MASK_AND_ALL_VALS)
         count = valueMask.countOn();
     if (!out || count == kSize) return readStored(c, out, count, codec, s);
-    s.values.resize(count);
+    s.values.resize(count + 1);  // one spare: the branch-free loop below reads one past the last
     readStored(c, s.values.data(), count, codec, s);
-    for (uint32_t i = 0, k = 0; i < kSize; ++i)
-        out[i] = valueMask.isOn(i) ? s.values[k++] : selection.isOn(i) ? inactive1 : inactive0;
+    expandActive(out, s.values.data(), valueMask, selection, inactive0, inactive1);
 }
 
 template <typename MaskT>
@@ -377,6 +398,29 @@ private:
     size_t index_ = std::numeric_limits<size_t>::max();
     std::string message_;
 };
+
+/// Stats::active on every active value of a leaf buffer (bit scans: no per-voxel iterator;
+/// the running range in locals: the buffer's floats could alias the Stats' own).
+void measureActive(float* values, const Leaf::NodeMaskType& mask, Stats& s) {
+    float lo = s.lo, hi = s.hi;
+    uint64_t nonFinite = 0;
+    for (uint32_t w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
+        float* v = values + 64 * w;
+        for (uint64_t on = mask.getWord<uint64_t>(w); on != 0; on &= on - 1) {
+            float& x = v[std::countr_zero(on)];
+            if (!std::isfinite(x)) {
+                x = 0.0f;
+                ++nonFinite;
+                continue;
+            }
+            lo = std::min(lo, x);
+            hi = std::max(hi, x);
+        }
+    }
+    s.lo = lo;
+    s.hi = hi;
+    s.nonFinite += nonFinite;
+}
 
 bool sameBits(float a, float b) { return std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b); }
 
@@ -501,7 +545,7 @@ private:
                 readValues<V>(c, wide, mask, codec_, scratch);
                 for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) out[i] = float(wide[i]);
             }
-            for (auto it = mask.beginOn(); it; ++it) out[it.pos()] = s.active(out[it.pos()], 1);
+            measureActive(out, mask, s);
         } catch (const Error& e) {
             errors_.add(index, e.what());
         } catch (const std::bad_alloc&) {
