@@ -34,6 +34,7 @@
 #include <cstring>
 #include <istream>
 #include <limits>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <streambuf>
@@ -64,6 +65,10 @@ constexpr uint32_t kFirstVersion = 222;  ///< OPENVDB_FILE_VERSION_NODE_MASK_COM
 constexpr uint32_t kLastVersion = openvdb::OPENVDB_FILE_VERSION;
 constexpr uint64_t kMaxStringBytes = 1 << 16;  ///< longer grid names or type names are left to OpenVDB
 constexpr uint64_t kLeafGrain = 64;            ///< leaves per parallel task
+/// Leaves located, then read in parallel, per batch; the file's bytes behind a batch are
+/// released before the next (so the mapped file and the tree are never both whole in memory).
+constexpr size_t kLeafBatch = 4096;
+constexpr uint64_t kPrefetchBytes = 8 << 20;   ///< bytes prefaulted ahead of each batch
 
 /// Thrown where this reader leaves the file to OpenVDB.
 struct Unsupported {
@@ -75,6 +80,9 @@ struct Image {
     const char* data;
     uint64_t size;
     const std::string& label;
+    /// Says that bytes [begin, end) are about to be read (a mapped file prefaults them) and
+    /// that bytes before @p end are no longer needed (it drops them from this process); no-ops when empty.
+    std::function<void(uint64_t, uint64_t)> willNeed = {}, release = {};
 };
 
 /// Bounds-checked reads from [pos, end) of an Image.
@@ -456,10 +464,28 @@ public:
         return tree;
     }
 
-    /// Walks the buffers section [pos, end) (bounds and chunk headers, in file order).
-    void locateLeaves(Cursor& c) {
+    /// Reads every leaf's values from the buffers section @p c, batch by batch: the batch's
+    /// chunk headers walked in file order (bounds checked), then its leaves read in parallel.
+    /// The first damaged leaf in file order is the error, whatever the threads did.
+    Stats readLeaves(Cursor& c) {
+        Stats all = stats_;
+        for (size_t first = 0; first < leaves_.size(); first += kLeafBatch) {
+            const size_t last = std::min(leaves_.size(), first + kLeafBatch);
+            const uint64_t begin = c.pos();
+            if (f_.willNeed) f_.willNeed(begin, begin + std::min(c.left(), kPrefetchBytes));
+            locateLeaves(c, first, last);
+            all.merge(readBatch(first, last));
+            errors_.throwIfAny();
+            if (f_.release) f_.release(begin, c.pos());
+        }
+        return all;
+    }
+
+private:
+    void locateLeaves(Cursor& c, size_t first, size_t last) {
         Scratch<V> none;
-        for (LeafJob& job : leaves_) {
+        for (size_t i = first; i < last; ++i) {
+            LeafJob& job = leaves_[i];
             c.take(Leaf::NodeMaskType::memUsage(), "leaf value mask");
             job.begin = c.pos();
             readValues<V>(c, nullptr, job.leaf->getValueMask(), codec_, none);
@@ -467,10 +493,9 @@ public:
         }
     }
 
-    /// Reads every leaf's values (in parallel), then puts the leaves in the tree.
-    Stats readLeaves() {
-        const Stats leafStats = tbb::parallel_reduce(
-            tbb::blocked_range<size_t>(0, leaves_.size(), kLeafGrain), Stats{},
+    Stats readBatch(size_t first, size_t last) {
+        return tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(first, last, kLeafGrain), Stats{},
             [&](const tbb::blocked_range<size_t>& r, Stats s) {
                 Scratch<V> scratch;
                 for (size_t i = r.begin(); i != r.end(); ++i) readLeaf(i, scratch, s);
@@ -480,13 +505,8 @@ public:
                 a.merge(b);
                 return a;
             });
-        errors_.throwIfAny();
-        Stats all = stats_;
-        all.merge(leafStats);
-        return all;
     }
 
-private:
     Coord coord(Cursor& c, const char* what) {
         int32_t v[3];
         std::memcpy(v, c.take(12, what), 12);
@@ -601,8 +621,7 @@ ReadGrid readGrid(const Image& f, const Descriptor& d) {
     std::shared_ptr<FloatTree> tree = reader.readTopology(head);
     if (head.pos() != uint64_t(d.blockPos)) throw Unsupported{"topology that does not end at the grid's data offset"};
     Cursor buffers(f, uint64_t(d.blockPos), uint64_t(d.endPos));
-    reader.locateLeaves(buffers);
-    const Stats stats = reader.readLeaves();
+    const Stats stats = reader.readLeaves(buffers);
 
     ReadGrid out;
     out.grid = openvdb::FloatGrid::create(tree);
@@ -621,7 +640,8 @@ ReadGrid readGrid(const Image& f, const Descriptor& d) {
     return out;
 }
 
-/// The file mapped read-only (pages populated up front: one pass instead of a fault per page).
+/// The file mapped read-only. willNeed prefaults a range (one call instead of a fault per 16
+/// pages), release drops what lies before an offset from this process (the page cache keeps it).
 class MappedFile {
 public:
     explicit MappedFile(const std::string& path) {
@@ -634,7 +654,7 @@ public:
         }
         size_ = uint64_t(st.st_size);
         if (size_ > 0) {
-            void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+            void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
             if (p == MAP_FAILED) {
                 ::close(fd);
                 throw Error(path + ": cannot map for reading (" + std::strerror(errno) + ")");
@@ -650,18 +670,28 @@ public:
     MappedFile& operator=(const MappedFile&) = delete;
     const char* data() const { return data_; }
     uint64_t size() const { return size_; }
+    void willNeed(uint64_t begin, uint64_t end) const {
+        begin &= ~(kPage - 1);
+        if (end > begin) ::madvise(const_cast<char*>(data_) + begin, end - begin, MADV_POPULATE_READ);  // a hint: errors ignored
+    }
+    void release(uint64_t end) {
+        end &= ~(kPage - 1);
+        if (end <= released_) return;
+        ::madvise(const_cast<char*>(data_) + released_, end - released_, MADV_DONTNEED);
+        released_ = end;
+    }
 
 private:
+    static constexpr uint64_t kPage = 4096;
     const char* data_ = nullptr;
-    uint64_t size_ = 0;
+    uint64_t size_ = 0, released_ = 0;
 };
 
 }  // namespace
 
-std::optional<ReadGrid> readVdbGrid(const char* data, uint64_t size, const std::string& label,
-                                    const std::string& gridName, std::string* unsupported) {
+namespace {
+std::optional<ReadGrid> readImage(const Image& f, const std::string& gridName, std::string* unsupported) {
     initOpenVdb();  // the metadata, map and grid type registries
-    const Image f{data, size, label};
     try {
         const std::vector<Descriptor> all = readDescriptors(f);
         const Descriptor& d = chooseGrid(all, gridName);
@@ -670,13 +700,22 @@ std::optional<ReadGrid> readVdbGrid(const char* data, uint64_t size, const std::
         if (unsupported) *unsupported = u.why;
         return std::nullopt;
     } catch (const std::bad_alloc&) {
-        throw Error(label + ": out of memory reading the grid");
+        throw Error(f.label + ": out of memory reading the grid");
     }
+}
+}  // namespace
+
+std::optional<ReadGrid> readVdbGrid(const char* data, uint64_t size, const std::string& label,
+                                    const std::string& gridName, std::string* unsupported) {
+    return readImage(Image{data, size, label}, gridName, unsupported);
 }
 
 std::optional<ReadGrid> readVdbGrid(const std::string& path, const std::string& gridName, std::string* unsupported) {
-    const MappedFile file(path);
-    return readVdbGrid(file.data(), file.size(), path, gridName, unsupported);
+    MappedFile file(path);
+    Image f{file.data(), file.size(), path};
+    f.willNeed = [&](uint64_t begin, uint64_t end) { file.willNeed(begin, end); };
+    f.release = [&](uint64_t, uint64_t end) { file.release(end); };
+    return readImage(f, gridName, unsupported);
 }
 
 }  // namespace vdbsplat
