@@ -431,6 +431,24 @@ TEST_F(VdbReader, EveryOverwrittenByteEndsCleanly) {
     EXPECT_GT(left, 0);    // e.g. a node compression mode byte out of range
 }
 
+// More leaves than one batch (4096): read as OpenVDB reads them through the mapped file
+// (prefaulted ahead, released behind), and cut short in any batch, an Error.
+TEST_F(VdbReader, ManyLeavesAreReadBatchByBatch) {
+    auto g = openvdb::FloatGrid::create(0.0f);
+    g->setName("density");
+    for (int i = 0; i < 9000; ++i) g->tree().setValueOn(Coord(8 * (i % 100), 8 * (i / 100), i % 8), 0.001f * float(i));
+    ASSERT_EQ(g->tree().leafCount(), 9000u);
+    const std::string file = write("many.vdb", {g}, openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+    expectReadAsOpenVdb(file, "density");
+    const std::string good = slurp(file);
+    const Layout l = layoutOf(good);
+    for (const double at : {0.2, 0.5, 0.9}) {
+        std::string bad = good;
+        poke(bad, l.offsetsAt + 16, l.blockPos + int64_t(at * double(l.endPos - l.blockPos)));
+        EXPECT_TRUE(has(damagedError(bad), "truncated or corrupt VDB file")) << at;
+    }
+}
+
 TEST_F(VdbReader, FilesThatCannotBeMappedAreErrors) {
     EXPECT_TRUE(has(errorOf([&] { readVdbGrid(path("missing.vdb"), ""); }), "missing.vdb: cannot open for reading"));
     EXPECT_TRUE(has(errorOf([&] { readVdbGrid(dir_, ""); }), ": not a regular file"));
