@@ -115,6 +115,7 @@ public:
         pos_ = to;
     }
     uint64_t pos() const { return pos_; }
+    const char* here() const { return f_->data + pos_; }
     uint64_t left() const { return end_ - pos_; }
     [[noreturn]] void corrupt(const std::string& what) const {
         throw Error(f_->label + ": truncated or corrupt VDB file (" + what + " at byte " + std::to_string(pos_) +
@@ -588,11 +589,11 @@ private:
 /// the map type kept, a singular map left for loadVolume's check to name.
 openvdb::math::Transform::Ptr readTransform(Cursor& c) {
     const uint64_t begin = c.pos();
+    const char* start = c.here();
     const std::string type = c.string("grid transform type");
     const uint64_t bytes = vdbMapBytes(type);
     if (bytes == 0 || !openvdb::math::MapRegistry::isRegistered(type)) throw Unsupported{"a map type not read here"};
-    const char* map = c.take(bytes, "grid transform");
-    const char* start = map - (c.pos() - bytes - begin);
+    c.take(bytes, "grid transform");
     MemoryStream in(start, c.pos() - begin);
     openvdb::io::setCurrentVersion(in);  // the map layout of file versions 219 and later
     openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform();
@@ -605,15 +606,32 @@ openvdb::math::Transform::Ptr readTransform(Cursor& c) {
     return transform;
 }
 
+/// A metadata block as MetaMap::readMeta reads it, from bytes skipMetadata has walked
+/// ("file_delayed_load" dropped, as io::File drops it).
+openvdb::MetaMap readMetadata(Cursor& c) {
+    const char* start = c.here();
+    const uint64_t begin = c.pos();
+    skipMetadata(c);
+    MemoryStream in(start, c.pos() - begin);
+    openvdb::MetaMap meta;
+    try {
+        meta.readMeta(in);
+    } catch (const std::exception& e) {
+        c.corrupt("grid metadata (" + std::string(e.what()) + ")");
+    }
+    meta.removeMeta(openvdb::GridBase::META_FILE_DELAYED_LOAD);
+    return meta;
+}
+
+/// The grid of descriptor @p d: its header and topology in [gridPos, blockPos), its leaf
+/// buffers in [blockPos, endPos).
 template <typename V>
 ReadGrid readGrid(const Image& f, const Descriptor& d) {
     Cursor head(f, uint64_t(d.gridPos), uint64_t(d.blockPos));
     Codec<V> codec;
     codec.compression = head.get<uint32_t>("grid compression flags");
     codec.half = d.half;
-    const uint64_t metaBegin = head.pos();
-    skipMetadata(head);
-    const uint64_t metaEnd = head.pos();
+    const openvdb::MetaMap meta = readMetadata(head);
     const openvdb::math::Transform::Ptr transform = readTransform(head);
     if (head.get<int32_t>("tree buffer count") != 1) throw Unsupported{"a tree buffer count other than 1"};
     codec.background = head.get<V>("root background value");
@@ -625,14 +643,8 @@ ReadGrid readGrid(const Image& f, const Descriptor& d) {
 
     ReadGrid out;
     out.grid = openvdb::FloatGrid::create(tree);
+    static_cast<openvdb::MetaMap&>(*out.grid) = meta;
     out.grid->setTransform(transform);
-    MemoryStream meta(f.data + metaBegin, metaEnd - metaBegin);
-    try {
-        out.grid->readMeta(meta);
-    } catch (const std::exception& e) {
-        head.corrupt("grid metadata (" + std::string(e.what()) + ")");
-    }
-    out.grid->removeMeta(openvdb::GridBase::META_FILE_DELAYED_LOAD);  // as io::File drops it
     out.activeVoxels = out.grid->activeVoxelCount();
     out.nonFiniteCount = stats.nonFinite;
     out.valueMin = stats.lo <= stats.hi ? stats.lo : 0.0f;
