@@ -153,6 +153,30 @@ TEST_F(VdbReader, ReadsEveryGeneratedVolumeAsOpenVdbDoes) {
     }
 }
 
+// The value range is measured leaf by leaf in parallel lanes; of two equal extremes it keeps
+// the one a serial pass over the tree meets first, as before: only +0 and -0 can tell.
+TEST_F(VdbReader, RangeKeepsTheFirstOfEqualExtremesLikeASerialPass) {
+    for (const bool dense : {false, true}) {
+        for (const float first : {0.0f, -0.0f}) {
+            auto g = openvdb::FloatGrid::create(0.0f);
+            g->setName("density");
+            if (dense) g->tree().fill(openvdb::CoordBBox(Coord(0), Coord(7)), 1.0f, true);  // a full leaf
+            g->tree().setValueOn(Coord(0, 0, 2), first);       // lane 2 of the first word
+            g->tree().setValueOn(Coord(0, 0, 5), -first);      // lane 1: a naive lane merge picks this one
+            g->tree().setValueOn(Coord(64, 0, 0), -first);     // a later leaf
+            g->tree().setValueOn(Coord(0, 8, 0), std::numeric_limits<float>::quiet_NaN());  // not in the range
+            const std::string file = write("zeros.vdb", {g}, openvdb::io::COMPRESS_BLOSC);
+            const auto got = readVdbGrid(file, "");
+            ASSERT_TRUE(got);
+            const Volume want = plainRead(file, "density");
+            EXPECT_TRUE(sameBits(got->valueMin, want.valueMin)) << dense << " " << first;
+            EXPECT_TRUE(sameBits(got->valueMin, first)) << dense << " " << first;
+            EXPECT_TRUE(sameBits(got->valueMax, want.valueMax)) << dense << " " << first;
+            EXPECT_EQ(got->nonFiniteCount, 1u);
+        }
+    }
+}
+
 TEST_F(VdbReader, ChoosesTheGridLoadVolumeChose) {
     auto vel = openvdb::Vec3SGrid::create();
     vel->setName("vel");
