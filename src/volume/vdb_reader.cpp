@@ -212,7 +212,8 @@ const Descriptor& chooseGrid(const std::vector<Descriptor>& all, const std::stri
     std::vector<std::string> names;
     std::vector<bool> scalar;
     for (const Descriptor& d : all) names.push_back(d.name), scalar.push_back(isFloat(d.type) || isDouble(d.type));
-    size_t k = gridName.empty() ? defaultGridIndex(names, scalar) : size_t(std::find(names.begin(), names.end(), gridName) - names.begin());
+    const size_t k = gridName.empty() ? defaultGridIndex(names, scalar)
+                                      : size_t(std::find(names.begin(), names.end(), gridName) - names.begin());
     if (k >= all.size() || !scalar[k]) throw Unsupported{"no such float or double grid"};
     return all[k];
 }
