@@ -232,10 +232,11 @@ Volume loadDirectly(const std::string& path, const std::string& gridName) {
 
 namespace {
 // OpenVDB's reader, for what readVdbGrid leaves to it: the grid is read once, in a forked
-// child (OpenVDB's reader can crash on damaged data: there that is a one-line Error here), which hands it over as a float tree through a
-// memfd (volume/grid_transfer.h); the parent allocates the leaves meanwhile, then rebuilds
-// the tree, checking every byte, and sanitizes its values as it goes. OpenVDB's log lines are captured in the child and
-// written here only when the read succeeded, as before; this process's stderr is never redirected.
+// child (OpenVDB's reader can crash on damaged data: there that is a one-line Error here),
+// which hands it over as a float tree through a memfd (volume/grid_transfer.h); the parent
+// allocates the leaves meanwhile, then rebuilds the tree, checking every byte, and sanitizes
+// its values as it goes. OpenVDB's log lines are captured in the child and written here only
+// when the read succeeded, as before; this process's stderr is never redirected.
 Volume loadInChild(const std::string& path, const std::string& gridName) {
     TransferMemory transfer(path);
     ChildRead child(path, [&](const std::function<void(uint64_t)>& hint) {
