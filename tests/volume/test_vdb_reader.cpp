@@ -406,6 +406,35 @@ TEST_F(VdbReader, ChunksThatLieAreErrors) {
     EXPECT_TRUE(has(damagedError(bad), "raw chunk size"));
 }
 
+// Counts that lie: the grid's metadata count, the root node's tile and child counts.
+TEST_F(VdbReader, CountsThatLieAreErrors) {
+    const std::string good = slurp(write("counts.vdb", {smallMixed()}, openvdb::io::COMPRESS_BLOSC));
+    const Layout l = layoutOf(good);
+    // After the map (UniformScaleMap: five Vec3d): buffer count, background, tile and child counts.
+    const size_t map = good.find(std::string("\x0f\0\0\0UniformScaleMap", 19));
+    ASSERT_NE(map, std::string::npos);
+    const size_t tiles = map + 19 + 120 + 4 + 4, children = tiles + 4;
+    uint32_t tileCount = 0, childCount = 0;
+    std::memcpy(&tileCount, good.data() + tiles, 4);
+    std::memcpy(&childCount, good.data() + children, 4);
+    ASSERT_EQ(tileCount, 1u);   // the level-3 tile
+    ASSERT_EQ(childCount, 1u);  // the upper node at the origin holds the leaves and the lower tiles
+    for (const uint32_t lie : {0xFFFFFFFFu, 0x10000u}) {
+        std::string bad = good;
+        poke(bad, tiles, lie);
+        EXPECT_TRUE(has(damagedError(bad), "root node tile or child count")) << lie;
+        bad = good;
+        poke(bad, children, lie);
+        EXPECT_TRUE(has(damagedError(bad), "root node tile or child count")) << lie;
+    }
+    std::string bad = good;
+    poke(bad, children, childCount + 1);  // one more upper node than the topology holds
+    EXPECT_TRUE(has(damagedError(bad), "truncated or corrupt VDB file"));
+    bad = good;
+    poke(bad, size_t(l.gridPos) + 4, int32_t(0x7FFFFFFF));  // the grid's metadata count
+    EXPECT_TRUE(has(damagedError(bad), "metadata count"));
+}
+
 TEST_F(VdbReader, MasksThatDisagreeWithTheDataAreErrors) {
     namespace io = openvdb::io;
     // The last leaf's topology mask is the 64 bytes before blockPos; with active-mask
