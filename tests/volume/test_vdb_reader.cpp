@@ -59,22 +59,25 @@ std::string slurp(const std::string& file) {
 }
 
 /// Leaves whose inactive values take each of the seven forms the writer compresses
-/// differently (io::NO_MASK_OR_INACTIVE_VALS … NO_MASK_AND_ALL_VALS), background 2.
+/// differently (io::NO_MASK_OR_INACTIVE_VALS … NO_MASK_AND_ALL_VALS, in that order along x:
+/// checked by parsing a file written with COMPRESS_ZIP | COMPRESS_ACTIVE_MASK), background 2:
+/// all 2; all -2; all 5; 2 and -2; 2 and 7; 6 and 7; 1, 3 and 4.
 openvdb::FloatGrid::Ptr inactiveValueModes(const std::string& name) {
     auto g = openvdb::FloatGrid::create(2.0f);
     g->setName(name);
-    g->setGridClass(openvdb::GRID_LEVEL_SET);
     auto& tree = g->tree();
-    const float inactive[7][3] = {{2, 2, 2}, {-2, -2, -2}, {5, 5, 5}, {2, -2, 2}, {2, 7, 7}, {6, 7, 7}, {1, 3, 4}};
+    const std::vector<std::vector<float>> inactive = {{2}, {-2}, {5}, {2, -2}, {2, 7}, {6, 7}, {1, 3, 4}};
     for (int mode = 0; mode < 7; ++mode) {
         const Coord origin(16 * mode, 0, 0);
+        const std::vector<float>& values = inactive[size_t(mode)];
+        for (int i = 0; i < 512; ++i)
+            tree.setValueOff(origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7), values[size_t(i) % values.size()]);
         for (int i = 0; i < 8; ++i) tree.setValueOn(origin.offsetBy(i, i, i), 0.1f * float(i + mode));
-        for (int i = 0; i < 3; ++i) tree.setValueOff(origin.offsetBy(i, 7 - i, 0), inactive[mode][i]);
     }
     return g;
 }
 
-/// Every flavour of grid the reader covers, under @p prefix names.
+/// Every flavour of grid the reader covers, one grid each (names: float, double, half, …).
 openvdb::GridPtrVec coveredGrids() {
     auto f = mixedGrid<openvdb::FloatGrid>("float");
     f->setTransform(rotated());
@@ -100,7 +103,13 @@ openvdb::GridPtrVec coveredGrids() {
     modes->insertMeta("axis", openvdb::Vec3DMetadata(openvdb::Vec3d(1, 2, 3)));
     auto halfModes = inactiveValueModes("half-modes");
     halfModes->setSaveFloatAsHalf(true);
-    return {f, d, half, halfDouble, scaled, shifted, scaleShift, modes, halfModes};
+    openvdb::GridPtrVec all{f, d, half, halfDouble, scaled, shifted, scaleShift, modes, halfModes};
+    // OpenVDB never zips fog volumes and level sets (Archive::setGridCompression): most grids
+    // here are of class unknown, so that COMPRESS_ZIP reaches their nodes; one of each other.
+    for (auto& grid : all) grid->setGridClass(openvdb::GRID_UNKNOWN);
+    scaleShift->setGridClass(openvdb::GRID_FOG_VOLUME);
+    halfModes->setGridClass(openvdb::GRID_LEVEL_SET);
+    return all;
 }
 
 /// readVdbGrid reads @p name of @p file itself, into what OpenVDB reads (after loadVolume's
@@ -175,6 +184,36 @@ TEST_F(VdbReader, RangeKeepsTheFirstOfEqualExtremesLikeASerialPass) {
             EXPECT_EQ(got->nonFiniteCount, 1u);
         }
     }
+}
+
+// The test data above does reach all seven per-node modes: the leaf buffers of
+// inactiveValueModes, written with zlib and active-mask compression, walked here by hand.
+TEST_F(VdbReader, TestDataCoversEveryNodeCompressionMode) {
+    auto g = inactiveValueModes("modes");
+    g->setGridClass(openvdb::GRID_UNKNOWN);
+    const std::string bytes = slurp(write("modes.vdb", {g}, openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK));
+    int64_t gridPos = 0, blockPos = 0, endPos = 0;
+    size_t at = 8 + 4 + 8 + 1 + 36 + 4 + 4;  // header, no file metadata, grid count
+    for (int str = 0; str < 3; ++str) {
+        uint32_t n = 0;
+        std::memcpy(&n, bytes.data() + at, 4);
+        at += 4 + n;
+    }
+    std::memcpy(&gridPos, bytes.data() + at, 8);
+    std::memcpy(&blockPos, bytes.data() + at + 8, 8);
+    std::memcpy(&endPos, bytes.data() + at + 16, 8);
+    std::vector<int> modes;
+    for (size_t p = size_t(blockPos); p < size_t(endPos);) {
+        const int mode = bytes[p + 64];
+        modes.push_back(mode);
+        p += 64 + 1 + (mode == 2 || mode == 4 || mode == 5 ? 4 : 0) + (mode == 5 ? 4 : 0) +
+             (mode >= 3 && mode <= 5 ? 64 : 0);
+        int64_t n = 0;
+        std::memcpy(&n, bytes.data() + p, 8);
+        p += 8 + size_t(n > 0 ? n : -n);
+    }
+    EXPECT_EQ(modes, (std::vector<int>{0, 1, 2, 3, 4, 5, 6}));
+    expectReadAsOpenVdb(path("modes.vdb"), "modes");
 }
 
 TEST_F(VdbReader, ChoosesTheGridLoadVolumeChose) {
