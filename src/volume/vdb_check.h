@@ -4,7 +4,8 @@
 // allocations, megabyte error messages) or report "0 grids". This walks the header,
 // the file metadata and every grid descriptor (all length-prefixed) and checks that
 // each grid's recorded end offset lies inside the file, reading only a few hundred bytes.
-// Also owns openVdbFile (the pre-check, then OpenVDB's open), OpenVdbLogCapture, which
+// Also owns checkVdbFile (exists, regular, the pre-check: what every load does first),
+// openVdbFile (checkVdbFile, then OpenVDB's open), OpenVdbLogCapture, which
 // keeps OpenVDB's own log lines (it writes "WARNING: …" to std::cerr) out of the one-line
 // error a bad file gets, and readInChildProcess: OpenVDB's reader can corrupt its heap on
 // damaged leaf data (a flipped byte in a compressed chunk header, found by fuzzing), which
