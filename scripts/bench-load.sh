@@ -21,7 +21,7 @@ if [ ! -f "$OBJ" ] || [ "$OBJ" -ot scripts/bench-load.cpp ]; then
   nice c++ -std=c++20 -O2 -DNDEBUG -DGLM_FORCE_XYZW_ONLY -DGLM_ENABLE_EXPERIMENTAL -Isrc -c scripts/bench-load.cpp -o "$OBJ"
 fi
 if [ ! -x "$BIN" ] || [ "$BIN" -ot "$LIB" ] || [ "$BIN" -ot "$OBJ" ]; then
-  nice c++ "$OBJ" "$LIB" -o "$BIN" -lopenvdb -ltbb -lz $(pkg-config --libs Imath OpenEXR libpng) -lhwy -lpugixml -lpthread
+  nice c++ "$OBJ" "$LIB" -o "$BIN" -lopenvdb -ltbb -lz $(pkg-config --libs Imath OpenEXR libpng) -lhwy -lpugixml -lblosc -lpthread
 fi
 if [ $# -eq 0 ]; then
   V="$BUILD_DIR/vdbsplat"

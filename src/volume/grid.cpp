@@ -16,6 +16,7 @@
 #include "util/error.h"
 #include "volume/grid_transfer.h"
 #include "volume/vdb_check.h"
+#include "volume/vdb_reader.h"
 
 namespace vdbsplat {
 
@@ -229,13 +230,14 @@ Volume loadDirectly(const std::string& path, const std::string& gridName) {
 }
 }  // namespace
 
-// The grid is read once, in a forked child (OpenVDB's reader can crash on damaged data:
-// there that is a one-line Error here), which hands it over as a float tree through a
-// memfd (volume/grid_transfer.h); the parent allocates the leaves meanwhile, then rebuilds
-// the tree, checking every byte, and sanitizes its values as it goes. OpenVDB's log lines are captured in the child and
-// written here only when the read succeeded, as before; this process's stderr is never redirected.
-Volume loadVolume(const std::string& path, const std::string& gridName) {
-    initOpenVdb();
+namespace {
+// OpenVDB's reader, for what readVdbGrid leaves to it: the grid is read once, in a forked
+// child (OpenVDB's reader can crash on damaged data: there that is a one-line Error here),
+// which hands it over as a float tree through a memfd (volume/grid_transfer.h); the parent
+// allocates the leaves meanwhile, then rebuilds the tree, checking every byte, and sanitizes
+// its values as it goes. OpenVDB's log lines are captured in the child and written here only
+// when the read succeeded, as before; this process's stderr is never redirected.
+Volume loadInChild(const std::string& path, const std::string& gridName) {
     TransferMemory transfer(path);
     ChildRead child(path, [&](const std::function<void(uint64_t)>& hint) {
         OpenVdbLogCapture log;
@@ -269,6 +271,23 @@ Volume loadVolume(const std::string& path, const std::string& gridName) {
     v.nonFiniteCount = decoded.nonFiniteCount;
     v.valueMin = decoded.valueMin;
     v.valueMax = decoded.valueMax;
+    v.file = path;
+    return v;
+}
+}  // namespace
+
+// Valid files of the layouts OpenVDB 3-10 write are read in process by vdbsplat's own reader
+// (volume/vdb_reader.h), which checks every byte before it allocates or indexes from it;
+// whatever it does not cover goes to OpenVDB's reader in a forked child (loadInChild).
+Volume loadVolume(const std::string& path, const std::string& gridName) {
+    initOpenVdb();
+    checkVdbFile(path);
+    std::optional<ReadGrid> read = readVdbGrid(path, gridName);
+    if (!read) return loadInChild(path, gridName);
+    Volume v = wrapGrid(std::move(read->grid), path, read->activeVoxels);
+    v.nonFiniteCount = read->nonFiniteCount;
+    v.valueMin = read->valueMin;
+    v.valueMax = read->valueMax;
     v.file = path;
     return v;
 }

@@ -42,7 +42,9 @@ struct Volume {
 /// @brief Calls openvdb::initialize() once (thread-safe, idempotent).
 void initOpenVdb();
 
-/// @brief Loads grid @p gridName (or, if empty, the first float/double scalar grid) from @p path.
+/// @brief Loads grid @p gridName (or, if empty, defaultGridIndex's grid) from @p path: with
+/// vdbsplat's own reader (volume/vdb_reader.h), or what it does not cover with OpenVDB's in a
+/// forked child.
 /// @throw Error naming the file and the problem: missing, not a VDB, truncated or corrupt,
 /// no float grid, no grid of that name, an empty grid, or a transform that is not linear
 /// (frustum) or is singular. Any affine map is accepted (anisotropic voxels, rotation, shear).

@@ -241,11 +241,15 @@ void checkVdbStructure(const std::string& path) {
         checkSequentialGrids(r, version);
 }
 
-void openVdbFile(openvdb::io::File& file, const std::string& path) {
+void checkVdbFile(const std::string& path) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
     if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a regular file");
     checkVdbStructure(path);  // OpenVDB does not bound its reads on truncated files
+}
+
+void openVdbFile(openvdb::io::File& file, const std::string& path) {
+    checkVdbFile(path);
     try {
         file.open(/*delayLoad=*/false);
     } catch (const std::exception& e) {

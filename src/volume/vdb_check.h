@@ -4,7 +4,8 @@
 // allocations, megabyte error messages) or report "0 grids". This walks the header,
 // the file metadata and every grid descriptor (all length-prefixed) and checks that
 // each grid's recorded end offset lies inside the file, reading only a few hundred bytes.
-// Also owns openVdbFile (the pre-check, then OpenVDB's open), OpenVdbLogCapture, which
+// Also owns checkVdbFile (exists, regular, the pre-check: what every load does first),
+// openVdbFile (checkVdbFile, then OpenVDB's open), OpenVdbLogCapture, which
 // keeps OpenVDB's own log lines (it writes "WARNING: …" to std::cerr) out of the one-line
 // error a bad file gets, and readInChildProcess: OpenVDB's reader can corrupt its heap on
 // damaged leaf data (a flipped byte in a compressed chunk header, found by fuzzing), which
@@ -29,8 +30,11 @@ void checkVdbStructure(const std::string& path);
 /// (Transform::write: type name, then the map); 0 for other maps (a frustum: variable).
 uint64_t vdbMapBytes(const std::string& mapType);
 
-/// @brief Checks that @p path exists and is a regular file, runs checkVdbStructure, then
-/// opens @p file without delayed loading (so a truncated file fails here, not mid-render).
+/// @brief Checks that @p path exists and is a regular file, then runs checkVdbStructure.
+/// @throw Error naming @p path: no such file, not a regular file, not a VDB, truncated.
+void checkVdbFile(const std::string& path);
+
+/// @brief checkVdbFile, then opens @p file without delayed loading (so a truncated file fails here, not mid-render).
 /// @throw Error naming @p path: no such file, not a regular file, not a VDB, truncated.
 void openVdbFile(openvdb::io::File& file, const std::string& path);
 
