@@ -147,7 +147,9 @@ TEST(SlabProfile, FractionsSumToOne) {
         float sum = 0.f;
         for (int j = 0; j < kMaxSlabSpan; ++j) {
             EXPECT_GE(p.fraction[size_t(j)], 0.f);
-            if (j > 2 * reach || j < reach + lowest) EXPECT_EQ(p.fraction[size_t(j)], 0.f) << j;
+            if (j > 2 * reach || j < reach + lowest) {
+                EXPECT_EQ(p.fraction[size_t(j)], 0.f) << j;
+            }
             sum += p.fraction[size_t(j)];
         }
         EXPECT_NEAR(sum, 1.f, 4e-7f) << offset << " " << unit << " " << reach;

@@ -87,7 +87,9 @@ TEST(SlabCompositing, LoneKernelDepositsTheOpticalDepthOfTheKernelOrder) {
             const Image slabs = renderWith(c.volume, tf, s, &slabStats);
             EXPECT_EQ(kernelStats.points, slabStats.points) << c.name;
             EXPECT_EQ(kernelStats.splats, slabStats.splats) << c.name;
-            if (std::string(c.name) == "aggregate") EXPECT_GT(slabStats.lodAggregates, 0u);
+            if (std::string(c.name) == "aggregate") {
+                EXPECT_GT(slabStats.lodAggregates, 0u);
+            }
             double totalK = 0.0, totalS = 0.0;
             for (size_t i = 0; i < kernels.pixels.size(); ++i) {
                 const double k = opticalDepth(kernels.pixels[i]), q = opticalDepth(slabs.pixels[i]);
