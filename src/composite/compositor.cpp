@@ -399,7 +399,7 @@ void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t k, TilePixels& 
 /// Records are a cache miss each (a tile's list is sparse in records_): fetch them (and, in the
 /// slab order, their profiles) 8 ahead, and an exact-index splat's map (two lines) 4 ahead, once
 /// its record has arrived.
-void TileCompositor::prefetchAhead(std::span<const uint32_t> entries, size_t e, bool profiles) const {
+inline void TileCompositor::prefetchAhead(std::span<const uint32_t> entries, size_t e, bool profiles) const {
     constexpr size_t kAhead = 8, kMapAhead = 4;
     const auto lines = [](const auto* p) {
         const char* c = reinterpret_cast<const char*>(p);

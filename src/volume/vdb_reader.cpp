@@ -582,6 +582,12 @@ private:
             } else {
                 auto leaf = std::make_unique<Leaf>(openvdb::PartialCreate(), origin, bg_);  // no buffer yet
                 leaf->setValueMask(loadMask<Leaf::NodeMaskType>(c, "leaf value mask"));
+                // Its buffer now, beside the node (the values are written in parallel later): the
+                // renderer reads a leaf's mask and values together, and with the buffers allocated
+                // by the worker threads, away from their nodes, far views streamed 13 % slower
+                // (Engine far 400², session 6; 6 % with this). At most 2 KiB per 64 bytes of mask in
+                // the file, as OpenVDB's own read allocates.
+                leaf->allocate();
                 leaves_.push_back(LeafJob{leaf.get()});
                 node.addChild(leaf.release());
             }
