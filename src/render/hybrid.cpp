@@ -39,6 +39,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     StreamOptions streamOptions = settings.stream;
     streamOptions.slabThickness = settings.effectiveSlabThickness();
     const bool slabOrder = settings.effectiveCompositing() == CompositingOrder::Slabs;
+    streamOptions.depthSpread = slabOrder;  // the slab order's aggregate profiles read it
     // The slab order's automatic thickness (½ voxel) is widened for elongated kernels so that a
     // kernel spans at most 2·kMaxSlabReach slabs (R·sMax ≤ K·slab): voxels 1×1×2.5 get 0.92.
     if (slabOrder && settings.slabThickness == 0.0)

@@ -31,7 +31,7 @@ void VoxelBatch::resize(size_t n) {
     sigma.resize(n);
     color.resize(n);
     spread.resize(n);
-    depthSpread.resize(n);
+    depthSpread.resize(withDepthSpread ? n : 0);
     members.resize(n);
 }
 
@@ -354,7 +354,7 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
         out.sigma.push_back(w == 1.f ? cls.sigma : cls.sigma * w);
         out.color.push_back(cls.color);
         out.spread.push_back(0.f);
-        out.depthSpread.push_back(0.f);
+        if (options_.depthSpread) out.depthSpread.push_back(0.f);
         out.members.push_back(c < 0.5f ? 1 : 0);
     });
 }
@@ -486,8 +486,10 @@ void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, c
                 out.spread.push_back(float(std::max(spread - full, 0.0)));
                 // Along the view ray the whole second moment counts (world²): the depth profile of the
                 // cell's mass (--compositing slabs, composite/slab_profile.h), ωᵀ A Σ Aᵀ ω.
-                const glm::dvec3 uz = (v / glm::length(v)) * toView;
-                out.depthSpread.push_back(float(std::max(glm::dot(uz, cov * uz), 0.0)));
+                if (options_.depthSpread) {
+                    const glm::dvec3 uz = (v / glm::length(v)) * toView;
+                    out.depthSpread.push_back(float(std::max(glm::dot(uz, cov * uz), 0.0)));
+                }
                 out.members.push_back(counted ? a.n : 0);
                 if (counted) ++counts.aggregates, counts.aggregatedVoxels += a.n;
             }
@@ -508,7 +510,7 @@ void copyRecord(const VoxelBatch& src, size_t i, VoxelBatch& dst, size_t k) {
     dst.sigma[k] = src.sigma[i];
     dst.color[k] = src.color[i];
     dst.spread[k] = src.spread[i];
-    dst.depthSpread[k] = src.depthSpread[i];
+    if (dst.withDepthSpread) dst.depthSpread[k] = src.depthSpread[i];
     dst.members[k] = src.members[i];
 }
 }  // namespace
@@ -539,6 +541,7 @@ void VoxelStream::release(size_t blocks, float limit, VoxelBatch& batch) {
         }
     });
     for (size_t s = 0; s < sources; ++s) released[s + 1] += released[s], kept[s + 1] += kept[s];
+    batch.withDepthSpread = pendingNext_.withDepthSpread = options_.depthSpread;
     batch.resize(released[sources]);
     pendingNext_.resize(kept[sources]);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, sources, 16), [&](const tbb::blocked_range<size_t>& r) {
