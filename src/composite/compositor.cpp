@@ -401,15 +401,19 @@ void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t k, TilePixels& 
 /// its record has arrived.
 inline void TileCompositor::prefetchAhead(std::span<const uint32_t> entries, size_t e, bool profiles) const {
     constexpr size_t kAhead = 8, kMapAhead = 4;
-    const auto lines = [](const auto* p) {
-        const char* c = reinterpret_cast<const char*>(p);
-        __builtin_prefetch(c), __builtin_prefetch(c + sizeof(*p) - 1);
-    };
+    // The prefetches are written out here, not in a helper lambda: GCC compiled the lambda out of
+    // line, found it free of side effects and dropped its calls, as it did this whole function.
     if (e + kAhead < entries.size()) {
         __builtin_prefetch(&records_[entries[e + kAhead]]);
-        if (profiles) lines(&profiles_[entries[e + kAhead]]);
+        if (profiles) {
+            const char* c = reinterpret_cast<const char*>(&profiles_[entries[e + kAhead]]);
+            __builtin_prefetch(c), __builtin_prefetch(c + sizeof(SlabProfile) - 1);
+        }
     }
-    if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) lines(&maps_[entries[e + kMapAhead]]);
+    if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) {
+        const char* c = reinterpret_cast<const char*>(&maps_[entries[e + kMapAhead]]);
+        __builtin_prefetch(c), __builtin_prefetch(c + sizeof(ExactIndexMap) - 1);
+    }
 }
 
 void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) {
