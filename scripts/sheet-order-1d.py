@@ -35,15 +35,18 @@ def sheets(sigma, colour, z0, halves=False):
     return out
 
 
-n = 10
-cases = [("uniform colour 1", [0.5] * n, [1.0] * n),
-         ("lit first voxel 0.5, then 1", [0.5] * n, [0.5] + [1.0] * (n - 1)),
-         ("two lit voxels 0.5, then 1", [0.5] * n, [0.5, 0.5] + [1.0] * (n - 2)),
-         ("specular first voxel 1.2", [0.5] * n, [1.2] + [1.0] * (n - 1)),
+N = 10  # voxels along the ray
+CASES = [("uniform colour 1", [0.5] * N, [1.0] * N),
+         ("lit first voxel 0.5, then 1", [0.5] * N, [0.5] + [1.0] * (N - 1)),
+         ("two lit voxels 0.5, then 1", [0.5] * N, [0.5, 0.5] + [1.0] * (N - 2)),
+         ("specular first voxel 1.2", [0.5] * N, [1.2] + [1.0] * (N - 1)),
          ("dense 1 then thin 0.3", [0.5] * 5 + [0.15] * 5, [1.0] * 5 + [0.3] * 5),
-         ("thin 0.3 then dense 1", [0.15] * 5 + [0.5] * 5, [0.3] * 5 + [1.0] * 5)]
-print(f"{'profile (sigma per voxel, colour)':34s} {'continuous':>10s} {'sheet error':>12s} {'half-sheets':>12s}")
-for name, sigma, colour in cases:
-    z0 = np.arange(n, dtype=float)
-    c = continuous(sigma, colour, z0)
-    print(f"{name:34s} {c:10.4f} {sheets(sigma, colour, z0) - c:+12.4f} {sheets(sigma, colour, z0, True) - c:+12.4f}")
+         ("thin 0.3 then dense 1", [0.15] * 5 + [0.5] * 5, [0.3] * 5 + [1.0] * 5),
+         ("lit first, dense 2", [2.0] * N, [0.5] + [1.0] * (N - 1))]
+
+if __name__ == "__main__":
+    print(f"{'profile (sigma per voxel, colour)':34s} {'continuous':>10s} {'sheet error':>12s} {'half-sheets':>12s}")
+    for name, sigma, colour in CASES:
+        z0 = np.arange(N, dtype=float)
+        c = continuous(sigma, colour, z0)
+        print(f"{name:34s} {c:10.4f} {sheets(sigma, colour, z0) - c:+12.4f} {sheets(sigma, colour, z0, True) - c:+12.4f}")

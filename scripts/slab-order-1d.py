@@ -7,13 +7,17 @@ Phi((b - d)/s) - Phi((a - d)/s) for slab [a, b), d its centre), summed within ea
 tau*colour), each slab composited as one layer. Columns: the error of the kernel order, then of
 slabs of 1 voxel (boundaries at half voxels, then at whole voxels), 1/2 voxel (two phases) and 1/4.
 Usage: /usr/bin/python3 scripts/slab-order-1d.py   (needs python3-numpy)"""
+import importlib.util
 import os
 from math import erf, sqrt
 
 import numpy as np
 
-here = os.path.dirname(os.path.abspath(__file__))
-exec(open(os.path.join(here, "sheet-order-1d.py")).read().split("\nn = 10")[0])  # S, continuous, sheets
+# The kernel (S), the continuous integral, the kernel order and the cases: scripts/sheet-order-1d.py.
+_spec = importlib.util.spec_from_file_location("sheet_order_1d", os.path.join(os.path.dirname(os.path.abspath(__file__)), "sheet-order-1d.py"))
+sheet = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(sheet)
+S, continuous, sheets = sheet.S, sheet.continuous, sheet.sheets
 
 Phi = lambda x: 0.5 * (1 + erf(x / sqrt(2)))
 
@@ -33,17 +37,9 @@ def sliced(sigma, colour, z0, delta, offset=0.5):
     return out
 
 
-n = 10
-cases = [("uniform colour 1", [0.5] * n, [1.0] * n),
-         ("lit first voxel 0.5, then 1", [0.5] * n, [0.5] + [1.0] * (n - 1)),
-         ("two lit voxels 0.5, then 1", [0.5] * n, [0.5, 0.5] + [1.0] * (n - 2)),
-         ("specular first voxel 1.2", [0.5] * n, [1.2] + [1.0] * (n - 1)),
-         ("dense 1 then thin 0.3", [0.5] * 5 + [0.15] * 5, [1.0] * 5 + [0.3] * 5),
-         ("thin 0.3 then dense 1", [0.15] * 5 + [0.5] * 5, [0.3] * 5 + [1.0] * 5),
-         ("lit first, dense 2", [2.0] * n, [0.5] + [1.0] * (n - 1))]
 print(f"{'profile (sigma per voxel, colour)':32s} {'kernels':>8s} {'1 vox':>8s} {'1 vox@0':>8s} {'1/2':>8s} {'1/2@0':>8s} {'1/4':>8s}")
-for name, sigma, colour in cases:
-    z0 = np.arange(n, dtype=float)
+for name, sigma, colour in sheet.CASES:
+    z0 = np.arange(sheet.N, dtype=float)
     c = continuous(sigma, colour, z0)
     r = [sheets(sigma, colour, z0) - c] + [sliced(sigma, colour, z0, d, o) - c
                                            for d, o in ((1, 0.5), (1, 0.0), (0.5, 0.25), (0.5, 0.0), (0.25, 0.125))]

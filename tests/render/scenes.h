@@ -3,7 +3,9 @@
 #include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 #include <openvdb/math/Transform.h>
 
+#include "render/render.h"
 #include "render/settings.h"
+#include "volume/generate.h"
 #include "volume/grid.h"
 #include "volume/transfer_function.h"
 
@@ -44,6 +46,25 @@ inline RenderSettings settingsFor(RenderMode mode, double distance = 1.0, int si
     s.camera.distance = distance;
     s.spp = 9;
     return s;
+}
+
+/// Renders @p v (the stats into @p out when given).
+inline Image renderWith(const Volume& v, const TransferFunction& tf, const RenderSettings& s, RenderStats* out = nullptr) {
+    RenderStats stats;
+    Image image = render(v, tf, s, stats);
+    if (out) *out = stats;
+    return image;
+}
+
+/// Constant colour @p rgb and extinction @p sigma (per voxel length) for every value.
+inline TransferFunction constantTf(float sigma, glm::vec3 rgb = glm::vec3(1.f)) {
+    return TransferFunction::fromPoints("constant", {{0.f, rgb}, {1.f, rgb}}, {{0.f, sigma}, {1.f, sigma}});
+}
+
+/// The Marschner–Lobb test signal at 41³, built once.
+inline const Volume& marschnerLobb() {
+    static const Volume v = makeVolume(makeMarschnerLobb(41), "marschner-lobb-41");
+    return v;
 }
 
 }  // namespace vdbsplat::test

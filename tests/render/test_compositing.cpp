@@ -17,22 +17,9 @@ namespace {
 
 using test::boxVolume;
 using test::settingsFor;
-
-Image renderWith(const Volume& v, const TransferFunction& tf, const RenderSettings& s, RenderStats* out = nullptr) {
-    RenderStats stats;
-    Image image = render(v, tf, s, stats);
-    if (out) *out = stats;
-    return image;
-}
-
-TransferFunction constantTf(float sigma, glm::vec3 rgb = glm::vec3(1.f)) {
-    return TransferFunction::fromPoints("constant", {{0.f, rgb}, {1.f, rgb}}, {{0.f, sigma}, {1.f, sigma}});
-}
-
-const Volume& marschnerLobb() {
-    static const Volume v = makeVolume(makeMarschnerLobb(41), "marschner-lobb-41");
-    return v;
-}
+using test::constantTf;
+using test::marschnerLobb;
+using test::renderWith;
 
 RenderSettings withOrder(RenderSettings s, CompositingOrder order) {
     s.compositing = order;

@@ -17,6 +17,8 @@
 namespace vdbsplat {
 namespace {
 
+using test::constantTf;
+
 constexpr int kSize = 96;
 
 /// One density voxel of value @p value at the origin, voxel size @p h.
@@ -30,10 +32,6 @@ Volume emissionBox(const Volume& like, openvdb::Coord lo, openvdb::Coord hi) {
     grid->denseFill(openvdb::CoordBBox(lo, hi), 1.f, true);
     grid->tree().voxelizeActiveTiles();
     return makeVolume(grid, "test-emission");
-}
-
-TransferFunction constantTf(float sigma, glm::vec3 rgb) {
-    return TransferFunction::fromPoints("constant", {{0.f, rgb}, {1.f, rgb}}, {{0.f, sigma}, {1.f, sigma}});
 }
 
 /// The emission settings of a constant map: ε = scale · σ · c = @p epsilon (per voxel length).

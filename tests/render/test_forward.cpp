@@ -26,6 +26,9 @@ namespace {
 
 using test::boxVolume;
 using test::settingsFor;
+using test::constantTf;
+using test::marschnerLobb;
+using test::renderWith;
 
 constexpr int kSize = 96;
 /// Every forward mode, the study modes (ewa, swan, none; docs/modes.md) included.
@@ -44,18 +47,6 @@ RenderSettings lookingAt(RenderMode mode, glm::dvec3 eye, glm::dvec3 lookAt, dou
     return s;
 }
 
-Image renderWith(const Volume& v, const TransferFunction& tf, const RenderSettings& s, RenderStats* out = nullptr) {
-    RenderStats stats;
-    Image image = render(v, tf, s, stats);
-    if (out) *out = stats;
-    return image;
-}
-
-/// Constant colour @p rgb and extinction @p sigma (per voxel length) for every value.
-TransferFunction constantTf(float sigma, glm::vec3 rgb = glm::vec3(1.f)) {
-    return TransferFunction::fromPoints("constant", {{0.f, rgb}, {1.f, rgb}}, {{0.f, sigma}, {1.f, sigma}});
-}
-
 /// Mean premultiplied RGBA over the (2r+1)² pixels around the image centre.
 glm::dvec4 centreMean(const Image& image, int r = 1) {
     glm::dvec4 sum(0.0);
@@ -66,10 +57,6 @@ glm::dvec4 centreMean(const Image& image, int r = 1) {
 
 const Volume& checkerBox() {
     static const Volume v = makeVolume(makeCheckerBox(40), "checkerbox-40");
-    return v;
-}
-const Volume& marschnerLobb() {
-    static const Volume v = makeVolume(makeMarschnerLobb(41), "marschner-lobb-41");
     return v;
 }
 /// Issue 10's thin-structure volume (`vdbsplat generate tubes` with its defaults).

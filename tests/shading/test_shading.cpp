@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "metrics/metrics.h"
+#include "render/scenes.h"  // tests/render/scenes.h
 #include "render/render.h"
 #include "shading/shading.h"
 #include "shading/shading_field.h"
@@ -18,6 +19,9 @@
 
 namespace vdbsplat {
 namespace {
+
+using test::marschnerLobb;
+using test::renderWith;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -187,11 +191,6 @@ TEST(ShadingSettings, ValidateNamesTheFlag) {
 // ---------------------------------------------------------------------------------------------
 // The pass and end to end
 
-const Volume& marschnerLobb() {
-    static const Volume v = makeVolume(makeMarschnerLobb(41), "marschner-lobb-41");
-    return v;
-}
-
 RenderSettings settingsFor(RenderMode mode, double distance, const ShadingSettings& shading) {
     RenderSettings s;
     s.mode = mode;
@@ -200,11 +199,6 @@ RenderSettings settingsFor(RenderMode mode, double distance, const ShadingSettin
     s.spp = 9;
     s.shading = shading;
     return s;
-}
-
-Image renderWith(const Volume& v, const TransferFunction& tf, const RenderSettings& s) {
-    RenderStats stats;
-    return render(v, tf, s, stats);
 }
 
 void expectBitIdentical(const Image& a, const Image& b, const std::string& what) {
