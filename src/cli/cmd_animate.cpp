@@ -13,6 +13,7 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -402,6 +403,15 @@ int runAnimate(const Args& args) {
             throw Error(where + std::to_string(i) + " (time " + std::to_string(frames[i].time) + "): " + e.what());
         }
         cameraText += cameras.back().describe() + "\n";
+    }
+
+    // --subpixels auto is fixed for the whole path, so that a zoom never switches grids between
+    // two frames: 2 only where it would be 2 at every frame (render.h resolvedFor).
+    if (o.settings.subpixels == kAutoSubpixels) {
+        const bool everyFrameMinified = std::all_of(cameras.begin(), cameras.end(), [&](const Camera& c) {
+            return everyVoxelMinified(volume, c, o.settings.threshold);
+        });
+        o.settings.subpixels = o.settings.effectiveSubpixels(everyFrameMinified);
     }
 
     // What the frames are made of: --resume refuses a folder made otherwise.

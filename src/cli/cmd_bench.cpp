@@ -245,10 +245,11 @@ int runBench(const Args& args) {
     }
 
     // The table.
-    std::printf("vdbsplat bench: %s (grid '%s', %llu active voxels), %dx%d, fov %g, tf %s, threshold %g px, footprint %s, %s (%d subpixels)\n",
+    std::printf("vdbsplat bench: %s (grid '%s', %llu active voxels), %dx%d, fov %g, tf %s, threshold %g px, footprint %s, %s (%s subpixels)\n",
                 o.input.c_str(), volume.name.c_str(), (unsigned long long)volume.activeVoxels, o.base.camera.width,
                 o.base.camera.height, o.base.camera.fovDeg, o.base.transferFunction.c_str(), o.base.threshold,
-                toString(o.base.footprint).c_str(), toString(o.base.filterOrder).c_str(), o.base.subpixels);
+                toString(o.base.footprint).c_str(), toString(o.base.filterOrder).c_str(),
+                o.base.subpixels == kAutoSubpixels ? "auto" : std::to_string(o.base.subpixels).c_str());
     std::printf("threads %d (machine %u), %d timed run%s + %d warmup per view and mode, interleaved\n\n", threads,
                 machine, o.runs, o.runs == 1 ? "" : "s", o.warmup);
     std::printf("%8s  %-9s  %9s  %9s  %8s  %15s  %10s  %10s  %10s\n", "distance", "mode", "median_s", "min_s", "%splats",
@@ -298,7 +299,7 @@ int runBench(const Args& args) {
         j["threshold"] = o.base.threshold;
         j["footprint"] = toString(o.base.footprint);
         j["filter_order"] = toString(o.base.filterOrder);
-        j["subpixels"] = o.base.subpixels;
+        j["subpixels"] = o.base.subpixels == kAutoSubpixels ? nlohmann::json("auto") : nlohmann::json(o.base.subpixels);
         j["fov"] = o.base.camera.fovDeg;
         j["spp"] = o.base.spp;
         j["tables"] = o.base.tablesDir;  // "": the shipped tables

@@ -92,6 +92,7 @@ int runRender(const Args& args) {
     checkVoxelBudget(volume, settings);
     resolveLookAt(args, volume, settings);
     const Camera camera = cameraFor(volume, settings);  // validates eye/look-at/up before the work
+    settings = resolvedFor(volume, camera, settings);    // --subpixels auto: the k used, echoed below
 
     RenderStats stats;
     RenderControl control;

@@ -326,8 +326,9 @@ std::optional<Rendered> keptRender(const fs::path& stem, const std::string& hash
 }
 
 Rendered makeRender(const fs::path& stem, const std::string& hash, const nlohmann::json& identity, const Volume& volume,
-                    const TransferFunction& tf, const RenderSettings& s, const Camera& camera,
+                    const TransferFunction& tf, const RenderSettings& requested, const Camera& camera,
                     const RenderControl& control) {
+    const RenderSettings s = resolvedFor(volume, camera, requested);  // --subpixels auto: the k used
     RenderStats st;
     Rendered r;
     r.image = render(volume, tf, s, st, control);

@@ -75,8 +75,9 @@ constexpr RenderFlag kRenderFlags[] = {
      "primitive's optical depth, then composite (too opaque for structures\n"
      "1-2 px wide)"},
     {"--subpixels", "K", kQuality,
-     "postfilter: composite on K x K sub-pixels per pixel, 1..8 (default 1;\n"
-     "2 is closer to the reference, at up to 3.5x the time at close views)"},
+     "postfilter: composite on K x K sub-pixels per pixel, 1..8, or auto\n"
+     "(default: 2 with --shading phong where every voxel is a point, else 1);\n"
+     "2 is closer to the reference, at up to 3.5x the time at close views"},
     {"--compositing", "C", kQuality,
      "auto (default): slabs with --shading phong, else kernels; kernels:\n"
      "each splat composited whole at its centre's depth, points summed per\n"
@@ -129,7 +130,8 @@ constexpr RenderFlag kRenderFlags[] = {
 /// @brief --filter-order and --subpixels into @p s. @throw Error naming the flag.
 void applyFilterFlags(const Args& args, RenderSettings& s) {
     if (auto v = args.get("--filter-order")) s.filterOrder = parseFilterOrder(*v);
-    if (auto v = args.get("--subpixels")) s.subpixels = int(parseInt(*v, "--subpixels", 1, kMaxSubpixels));
+    if (auto v = args.get("--subpixels"))
+        s.subpixels = *v == "auto" ? kAutoSubpixels : int(parseInt(*v, "--subpixels", 1, kMaxSubpixels));
 }
 
 /// @brief The validated emission settings the emission flags in @p args describe.

@@ -20,11 +20,22 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+/// Largest projected voxel spacing (sub-pixels) drawn as a point on a grid of k ≥ 2 sub-pixels.
+constexpr double kMaxPointSpacingSubpx = 2.0;
+
 /// What the forward pipeline draws with, in the pixels of the image it composites on.
 struct ForwardPass {
     double threshold;          ///< τ (px): projected voxel spacing below which voxels are points
     double lodPx;              ///< level-of-detail cell size (px)
     double prefilterVariance;  ///< V_h folded into each primitive (px²)
+    /// The low-pass the level-of-detail rule weighs an aggregate's spread against (px²; volume/stream.h):
+    /// prefilterVariance, except on a grid of k sub-pixels, where it is V_s·k. With V_s alone the
+    /// grid draws far finer aggregates than the pixel grid (16× the points at the far checker box,
+    /// k = 2: 2.7× the time); with V_s·k², the pixel grid's cells, it loses what k = 2 gained
+    /// (checker box, Phong, far, 400², against the reference: V_s 57.4 dB in 0.112 s, V_s·k 56.1 dB
+    /// in 0.068 s, V_s·k² 54.5 dB in 0.037 s; Engine 69.4 / 71.1 / 64.2 dB in 0.107 / 0.067 / 0.066 s;
+    /// tubes 57.4 / 61.1 / –; docs/shading.md, session 7).
+    double lodPrefilterVariance;
 };
 
 /// Streams, projects and composites @p volume onto @p camera's pixels.
@@ -50,7 +61,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     streamOptions.slabsPerWindow = int(std::lround(streamOptions.slabsPerWindow / streamOptions.slabThickness));
     streamOptions.lodCellPx = pass.lodPx;
     streamOptions.lodBlend = settings.lodBlend;
-    streamOptions.pointPrefilterVariance = pass.prefilterVariance;
+    streamOptions.pointPrefilterVariance = pass.lodPrefilterVariance;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point ? INFINITY
                                  : drawsOnlySplats(settings.mode)   ? 0.0
                                                                     : pass.threshold;
@@ -150,6 +161,17 @@ std::optional<PixelRange> coveredPixels(const Volume& volume, const Camera& came
     return range;
 }
 
+/// τ on a grid of @p k sub-pixels per pixel: the same voxels are points as on the pixel grid
+/// (τ·k sub-pixels), but no more than kMaxPointSpacingSubpx sub-pixels apart: a point's filter
+/// (V = V_s + (s_g·s)², point_filter.h) must fit its 7×7 window, which a 3-sub-pixel voxel's does
+/// not (σ = 2 sub-pixels, cut at 1.75σ and renormalised: the points ripple; checker box, Phong,
+/// distance 2, 400²: 49.8 dB at k = 4 against 67.0 at k = 2, 70.3 with the cap). A τ the user set
+/// above the cap on the pixel grid (k = 1) is kept.
+double subpixelThreshold(double threshold, int k) {
+    if (k == 1) return threshold;
+    return std::min(threshold * k, std::max(threshold, kMaxPointSpacingSubpx));
+}
+
 /// A @p width × @p height image, transparent (T = 1, no radiance) except for @p part at (@p x0, @p y0).
 Image placed(const Image& part, int x0, int y0, int width, int height) {
     Image out(width, height);
@@ -170,7 +192,8 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     // low-pass at all, and no level of detail (an aggregate is a prefiltered point).
     if (settings.filterOrder == FilterOrder::Prefilter || modeFixesFilterOrder(settings.mode)) {
         const bool none = settings.mode == RenderMode::None;
-        const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, none ? 0.0 : kPrefilterVariance};
+        const double v = none ? 0.0 : kPrefilterVariance;
+        const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, v, v};
         const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, *tables.kernel), 0);
         if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control, emission);
         const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
@@ -184,7 +207,8 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     const SubpixelGrid grid = makeSubpixelGrid(settings.subpixels, kPrefilterVariance);
     const Camera fine = subpixelCamera(camera, grid);
     const int k = grid.k;
-    const ForwardPass pass{settings.threshold * k, settings.lodPx * k, grid.fineVariance};
+    const ForwardPass pass{subpixelThreshold(settings.threshold, k), settings.lodPx * k, grid.fineVariance,
+                           grid.fineVariance * k};
     // Deposits reach depositReachPx sub-pixels (≤ that many pixels) past the kernels; the output
     // pixels they reach through the filter lie within `border` more; the crop of the sub-pixel
     // image is that output rectangle with its own border, as subpixelCamera frames the whole image.

@@ -1,10 +1,13 @@
 // render/render.cpp — mode dispatch (see render.h).
 #include "render/render.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
+#include "footprint/ellipsoid.h"
 #include "footprint/tables.h"
 #include "render/hybrid.h"
 #include "render/reference.h"
@@ -66,16 +69,38 @@ Camera cameraFor(const Volume& volume, const RenderSettings& settings) {
     return makeCamera(settings.camera, lo, hi);
 }
 
-Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings, RenderStats& stats,
+bool everyVoxelMinified(const Volume& volume, const Camera& camera, double thresholdPx) {
+    if (volume.indexBox.empty()) return false;
+    const openvdb::CoordBBox& box = volume.indexBox;
+    const glm::dmat3 A(volume.indexToWorld);
+    const double largestAxis = volume.isotropic ? volume.voxelSize : singularValues(A).x;
+    double zNear = INFINITY;
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 idx(corner & 1 ? box.max().x() : box.min().x(), corner & 2 ? box.max().y() : box.min().y(),
+                             corner & 4 ? box.max().z() : box.min().z());
+        zNear = std::min(zNear, camera.toView(glm::dvec3(volume.indexToWorld * glm::dvec4(idx, 1.0))).z);
+    }
+    // The depth is linear over the box, so its least value is at a corner.
+    return zNear > 0.0 && largestAxis * camera.focal() / zNear < thresholdPx;
+}
+
+RenderSettings resolvedFor(const Volume& volume, const Camera& camera, RenderSettings settings) {
+    if (settings.subpixels == kAutoSubpixels)
+        settings.subpixels = settings.effectiveSubpixels(everyVoxelMinified(volume, camera, settings.threshold));
+    return settings;
+}
+
+Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& requested, RenderStats& stats,
              const RenderControl& control) {
     const auto start = std::chrono::steady_clock::now();
     if (control.stop && control.stop()) throw RenderStopped("render stopped before it began");
-    checkVoxelBudget(volume, settings);
-    checkKernelShape(volume, settings);
+    checkVoxelBudget(volume, requested);
+    checkKernelShape(volume, requested);
     float lo, hi;
     normalizationRange(volume, lo, hi);
     const ClassificationTable table = tf.bake(lo, hi, volume.voxelSize);
-    const Camera camera = cameraFor(volume, settings);
+    const Camera camera = cameraFor(volume, requested);
+    const RenderSettings settings = resolvedFor(volume, camera, requested);
     stats.activeVoxels = volume.activeVoxels;
     // Shading (docs/shading.md): one VoxelShader for every mode. The reference reads each voxel
     // many times and takes the whole field, computed once; the forward modes shade the voxels

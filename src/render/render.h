@@ -25,6 +25,16 @@ void checkVoxelBudget(const Volume& volume, const RenderSettings& settings);
 /// diagonals from the grid.
 Camera cameraFor(const Volume& volume, const RenderSettings& settings);
 
+/// @brief True when every active voxel of @p volume projects under @p thresholdPx pixels on
+/// @p camera (all would be points): the projected spacing (longest voxel axis)·f/z at the
+/// nearest corner of the active voxels' box. False when a corner lies at or behind the eye.
+bool everyVoxelMinified(const Volume& volume, const Camera& camera, double thresholdPx);
+
+/// @brief @p settings with what is automatic for a view made concrete for @p volume on @p camera:
+/// subpixels (RenderSettings::effectiveSubpixels). render() renders with it; callers use it to
+/// echo the settings an image was made with.
+RenderSettings resolvedFor(const Volume& volume, const Camera& camera, RenderSettings settings);
+
 /// @brief Renders @p volume with @p settings (already validated) and transfer function @p tf.
 /// Uses the calling thread's TBB arena (the caller limits threads with tbb::global_control).
 /// @throw Error for settings the mode cannot honour.

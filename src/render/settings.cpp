@@ -53,8 +53,8 @@ void RenderSettings::validate() const {
     if (!(std::isfinite(threshold) && threshold > 0.0)) throw Error("--threshold: must be a positive number of pixels");
     if (!(std::isfinite(lodPx) && lodPx >= 0.0 && lodPx <= 64.0))
         throw Error("--lod: must be a number of pixels in [0, 64] (0 turns level of detail off)");
-    if (subpixels < 1 || subpixels > kMaxSubpixels)
-        throw Error("--subpixels: must be in [1, " + std::to_string(kMaxSubpixels) + "]");
+    if ((subpixels < 1 && subpixels != kAutoSubpixels) || subpixels > kMaxSubpixels)
+        throw Error("--subpixels: must be 'auto' or in [1, " + std::to_string(kMaxSubpixels) + "]");
     if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
         throw Error("--max-voxels: must be in [1, " + std::to_string(kHardMaxActiveVoxels) + "]");
     if (!(slabThickness == 0.0 || (slabThickness >= 0.5 && slabThickness <= 1.0)))
@@ -128,7 +128,10 @@ nlohmann::json RenderSettings::toJson() const {
     j["kernel"] = kernel;
     // Ewa and Swan filter each primitive, None filters nothing (RenderMode): echo what was used.
     j["filter_order"] = mode == RenderMode::None ? "none" : modeFixesFilterOrder(mode) ? "prefilter" : toString(filterOrder);
-    j["subpixels"] = modeFixesFilterOrder(mode) ? 1 : subpixels;
+    // "auto" only where nothing resolved it for a view (render.h resolvedFor does).
+    if (modeFixesFilterOrder(mode)) j["subpixels"] = 1;
+    else if (subpixels == kAutoSubpixels) j["subpixels"] = "auto";
+    else j["subpixels"] = subpixels;
     j["show_primitives"] = showPrimitives;
     j["lod"] = mode == RenderMode::None ? 0.0 : lodPx;
     if (!lodBlend) j["lod_blend"] = false;  // absent when on: default outputs unchanged

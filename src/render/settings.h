@@ -55,10 +55,11 @@ std::string toString(FilterOrder order);
 std::optional<CompositingOrder> parseCompositingOrder(const std::string& name);
 std::string toString(CompositingOrder order);
 
-/// Postfilter: sub-pixels per axis by default and the most --subpixels accepts.
+/// Postfilter: sub-pixels per axis. kAutoSubpixels (`--subpixels auto`, the default) lets
+/// RenderSettings::effectiveSubpixels decide per view; kMaxSubpixels is the most --subpixels accepts.
 /// k = 1 with a small V_s already reaches 45–60 dB on the tubes at the cost of the prefilter
 /// order; k = 2 adds 0–6 dB for 2–3.5× the time at close views (docs/performance.md).
-inline constexpr int kDefaultSubpixels = 1, kMaxSubpixels = 8;
+inline constexpr int kAutoSubpixels = 0, kDefaultSubpixels = kAutoSubpixels, kMaxSubpixels = 8;
 
 /// @throw Error "--footprint: expected 'auto', 'table' or 'exact', got '<name>'".
 FootprintPath parseFootprintPath(const std::string& name);
@@ -96,7 +97,19 @@ struct RenderSettings {
     /// The reconstruction kernel (--kernel; KernelShape::named): every mode and the reference.
     std::string kernel = "gaussian";
     FilterOrder filterOrder = FilterOrder::Postfilter;
-    int subpixels = kDefaultSubpixels;      ///< Postfilter: sub-pixel grid per axis
+    /// Postfilter: sub-pixel grid per axis, 1..kMaxSubpixels; kAutoSubpixels: effectiveSubpixels().
+    int subpixels = kDefaultSubpixels;
+    /// The grid used: as set, else 2 where Phong shading meets a view in which every voxel is a
+    /// point (@p everyVoxelMinified: render.h everyVoxelMinified), else 1. Why: a pixel then spans
+    /// several voxels of a surface seen at an angle, so its depth slabs mix the lit shell of the
+    /// surface with the layers behind it, whose colour the rays never see (checker box, far view:
+    /// 49.4 dB at k = 1, 57.4 at k = 2; docs/shading.md). Unshaded colour does not change from
+    /// layer to layer, and at framed and close views a pixel spans under a voxel: k = 1 there.
+    /// A view-dependent k switches once along a zoom; `animate` fixes it for the whole path.
+    int effectiveSubpixels(bool everyVoxelMinified) const {
+        if (subpixels != kAutoSubpixels) return subpixels;
+        return shading.mode == ShadingMode::Phong && everyVoxelMinified ? 2 : 1;
+    }
     bool showPrimitives = false;            ///< tint splats red (seed Figure 8a)
     /// Level of detail for minified voxels (DESIGN §8.2): points are aggregated over cells of
     /// 2, 4 or 8 voxels per side whose side projects to at most this many pixels; 0: off.

@@ -20,6 +20,7 @@
 #include <string>
 #include <thread>
 #include <vector>
+#include <nlohmann/json.hpp>
 
 #include "image/image.h"
 #include "support/cli.h"
@@ -103,6 +104,21 @@ TEST_F(AnimateCli, ZoomWritesFramesAndCsv) {
     // The far frame is mostly points, the near one mostly splats.
     EXPECT_LT(std::stod(fields(csv[1])[10]), std::stod(fields(csv[4])[10]));
     EXPECT_TRUE(fs::exists(dir + "/animation.json"));
+}
+
+// --subpixels auto is fixed once for the whole path (a zoom never switches grids between two
+// frames): 2 for a shaded path that stays among points, 1 for one that reaches splats or is
+// unshaded (animation.json records the k every frame used).
+TEST_F(AnimateCli, AutoSubpixelsAreFixedForThePath) {
+    struct Case { const char* name; const char* args; int k; };
+    for (const Case c : {Case{"far", "--from 8 --to 4 --shading phong", 2}, Case{"through", "--from 8 --to 1 --shading phong", 1},
+                         Case{"unshaded", "--from 8 --to 4", 1}}) {
+        const std::string dir = out(c.name);
+        const CliResult r = animate("-o '" + dir + "' " + c.args + " --frames 3 --size 48x48");
+        ASSERT_EQ(r.rc, 0) << r.err;
+        const nlohmann::json record = nlohmann::json::parse(slurp(dir + "/animation.json"));
+        EXPECT_EQ(record.at("settings").at("subpixels"), c.k) << c.name;
+    }
 }
 
 TEST_F(AnimateCli, ResumeKeepsFramesAndRerendersADeletedOne) {

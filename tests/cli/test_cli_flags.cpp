@@ -169,6 +169,8 @@ TEST_F(CliFlags, SharedFlagsAreParsedAlike) {
         {"--threads 2000", "--threads"},
         {"--threads 1.5", "--threads"},
         {"--subpixels 9", "--subpixels"},
+        {"--subpixels 0", "--subpixels"},
+        {"--subpixels automatic", "--subpixels"},
         {"--filter-order sideways", "--filter-order"},
         {"--footprint fast", "--footprint"},
         {"--simd maybe", "--simd"},

@@ -476,6 +476,31 @@ TEST_F(CliRender, StatsJsonEchoesStudyModesAndKernel) {
     }
 }
 
+// --subpixels auto (the default) echoes the k it used for the view: 2 for a shaded view of
+// points only, 1 unshaded or where voxels are splats; an explicit k as given.
+TEST_F(CliRender, StatsJsonEchoesTheSubpixelsUsed) {
+    const fs::path d = runDir("stats-subpixels");
+    struct Expect { const char* name; std::vector<std::string> flags; int k; };
+    for (const Expect& e : {Expect{"far-shaded", {"--shading", "phong", "--distance", "8"}, 2},
+                            Expect{"far", {"--distance", "8"}, 1},
+                            Expect{"close-shaded", {"--shading", "phong", "--distance", "0.35"}, 1},
+                            Expect{"far-shaded-1", {"--shading", "phong", "--distance", "8", "--subpixels", "1"}, 1},
+                            Expect{"far-auto-3", {"--distance", "8", "--subpixels", "auto", "--subpixels", "3"}, -1}}) {
+        const fs::path stats = d / "out" / (std::string(e.name) + ".json");
+        std::vector<std::string> flags = e.flags;
+        flags.insert(flags.end(), {"--size", "48x48", "--stats", stats.string()});
+        const Result r = runBinary(renderArgs(vdb("sphere.vdb"), (d / "out" / (std::string(e.name) + ".png")).string(),
+                                              "hybrid", flags),
+                                   d / "log");
+        if (e.k < 0) {  // given twice
+            EXPECT_EQ(r.rc, 1) << e.name;
+            continue;
+        }
+        ASSERT_EQ(r.rc, 0) << e.name << ": " << r.err;
+        EXPECT_EQ(nlohmann::json::parse(slurp(stats))["subpixels"], e.k) << e.name;
+    }
+}
+
 TEST_F(CliRender, StatsJsonHasCountsTimingsAndSettings) {
     const fs::path d = runDir("stats");
     const fs::path stats = d / "out" / "s.json";
