@@ -345,6 +345,8 @@ TEST(Stream, BlendedLevelsKeepTheEnergy) {
 }  // namespace
 }  // namespace vdbsplat
 
+#include <hwy/targets.h>
+
 #include "volume/leaf_moments.h"
 
 namespace vdbsplat {
@@ -353,8 +355,28 @@ namespace {
 // The vectorised whole-leaf sums against the same sums in double, one voxel at a time: a
 // partly active leaf (mask words), a dense one (no mask), values outside the table's range,
 // NaN and infinity (σ = 0, not counted), and a colour-varying table.
+void expectLeafMomentsMatchTheSums();
+
+// On the widest vectors this CPU has, and again on AVX2 (8 lanes: one row per vector, lane pairs
+// of 4 doubles) where the CPU has wider ones, so that both row layouts are tested here.
 TEST(LeafMoments, MatchTheSumsVoxelByVoxel) {
     if (!leafMomentsSupported()) GTEST_SKIP() << "this CPU's vectors do not hold whole 8-voxel rows (scalar sums only)";
+    {
+        SCOPED_TRACE("best target");
+        expectLeafMomentsMatchTheSums();
+    }
+#if HWY_ARCH_X86
+    if ((hwy::SupportedTargets() & HWY_AVX2) && hwy::SupportedTargets() != HWY_AVX2) {
+        hwy::SetSupportedTargetsForTest(HWY_AVX2);
+        ASSERT_TRUE(leafMomentsSupported());
+        SCOPED_TRACE("AVX2");
+        expectLeafMomentsMatchTheSums();
+        hwy::SetSupportedTargetsForTest(0);  // back to what the CPU has
+    }
+#endif
+}
+
+void expectLeafMomentsMatchTheSums() {
     std::vector<Classified> entries(ClassificationTable::kSize);
     for (int i = 0; i < ClassificationTable::kSize; ++i) {
         const float t = float(i) / float(ClassificationTable::kSize - 1);
