@@ -6,19 +6,49 @@
 #pragma once
 #include <glm/glm.hpp>
 #include <cstdint>
+#include <cstdlib>
+#include <new>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vdbsplat {
 
+/// Allocates zeroed memory (calloc) and value-initialises elements by leaving them as they are: a
+/// vector sized once on this allocator is all zeros without writing them, and a large one is pages
+/// the kernel maps as zeros when first touched (a far view's 1024² output image: 16 MB of which
+/// the render writes a few rows, and writing the PNG only reads). Only for vectors sized once, at
+/// construction: a vector shrunk and grown again would keep stale elements. @tparam T trivial.
+template <class T>
+struct ZeroedAllocator {
+    using value_type = T;
+    ZeroedAllocator() = default;
+    template <class U>
+    ZeroedAllocator(const ZeroedAllocator<U>&) noexcept {}
+    T* allocate(size_t n) {
+        if (void* p = std::calloc(n, sizeof(T))) return static_cast<T*>(p);
+        throw std::bad_alloc();
+    }
+    void deallocate(T* p, size_t) noexcept { std::free(p); }
+    template <class U>
+    void construct(U*) noexcept {}  // value-initialisation: the memory is already zero
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+    template <class U>
+    bool operator==(const ZeroedAllocator<U>&) const noexcept { return true; }
+};
+
 struct Image {
     int width = 0;
     int height = 0;
-    std::vector<glm::vec4> pixels;  ///< premultiplied linear RGBA, index y * width + x
+    /// Premultiplied linear RGBA, index y * width + x; all zero (transparent) when constructed.
+    std::vector<glm::vec4, ZeroedAllocator<glm::vec4>> pixels;
 
     Image() = default;
-    Image(int w, int h) : width(w), height(h), pixels(size_t(w) * size_t(h), glm::vec4(0.0f)) {}
+    Image(int w, int h) : width(w), height(h), pixels(size_t(w) * size_t(h)) {}
     glm::vec4& at(int x, int y) { return pixels[size_t(y) * width + x]; }
     const glm::vec4& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
 };
