@@ -3,6 +3,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -92,26 +93,31 @@ void VoxelStream::collectBlocks() {
                     all.push_back({openvdb::Coord(x, y, z), kBlockDim, nullptr, *it, 0.f, 0.f,
                                    uint32_t(kBlockDim * kBlockDim * kBlockDim), 0, 0.f});
     }
-    // Distance bounds of voxel centres: the block's bounding sphere around its centre.
+    // Distance bounds of voxel centres (the block's bounding sphere around its centre), the frustum
+    // test and the level of detail, block by block in parallel (each writes only its own block).
     const double halfDiagonal = blockHalfDiagonal_;
-    for (Block& b : all) {
-        const glm::dvec3 centreIdx = glm::dvec3(b.origin.x(), b.origin.y(), b.origin.z()) + 0.5 * (b.dim - 1);
-        const glm::dvec3 centre(volume_.indexToWorld * glm::dvec4(centreIdx, 1.0));
-        const double dist = glm::length(centre - camera_.eye());
-        b.dMin = float(std::max(0.0, dist - halfDiagonal));
-        b.dMax = float(dist + halfDiagonal);
-    }
-    blocks_.clear();
-    for (Block& b : all) {
-        if (!visible(b)) {
-            counts_.frustum += b.voxels;
-            continue;
+    std::vector<uint8_t> inside(all.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, all.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            Block& b = all[i];
+            const glm::dvec3 centreIdx = glm::dvec3(b.origin.x(), b.origin.y(), b.origin.z()) + 0.5 * (b.dim - 1);
+            const glm::dvec3 centre(volume_.indexToWorld * glm::dvec4(centreIdx, 1.0));
+            const double dist = glm::length(centre - camera_.eye());
+            b.dMin = float(std::max(0.0, dist - halfDiagonal));
+            b.dMax = float(dist + halfDiagonal);
+            inside[i] = visible(b);
+            if (inside[i]) lodLevel(b);
         }
-        lodLevel(b);
-        blocks_.push_back(b);
+    });
+    blocks_.clear();
+    blocks_.reserve(all.size());
+    for (size_t i = 0; i < all.size(); ++i) {
+        if (inside[i]) blocks_.push_back(all[i]);
+        else counts_.frustum += all[i].voxels;
     }
-    // Front to back by nearest distance; ties broken by position so the order is total.
-    std::sort(blocks_.begin(), blocks_.end(), [](const Block& a, const Block& b) {
+    // Front to back by nearest distance; ties broken by position so the order is total (and the
+    // parallel sort's result the one order there is, whatever the thread count).
+    tbb::parallel_sort(blocks_.begin(), blocks_.end(), [](const Block& a, const Block& b) {
         if (a.dMin != b.dMin) return a.dMin < b.dMin;
         return a.origin < b.origin;
     });
