@@ -26,6 +26,7 @@
 #include <unistd.h>
 
 #include <openvdb/Metadata.h>
+#include <tbb/global_control.h>
 
 #include "util/error.h"
 #include "volume/grid.h"
@@ -270,6 +271,18 @@ void OpenVdbLogCapture::keep() {
     std::cerr << held_.str();
 }
 
+namespace {
+/// TBB is not fork-safe: a child inherits the scheduler's state but not its worker threads, nor
+/// the locks they held, so a parallel_for there (OpenVDB frees a tree's leaves with one, as the
+/// child's grid goes out of scope) can wait for ever. Before forking, wait for the workers to end
+/// (oneTBB's documented way to fork: tbb::finalize; the next parallel call starts them again, a
+/// few tens of µs). Should it not manage (called inside a parallel region), fork as before.
+void waitForTbbWorkers() {
+    tbb::task_scheduler_handle handle{tbb::attach{}};
+    (void)tbb::finalize(handle, std::nothrow);
+}
+}  // namespace
+
 // The pipe carries messages: 'H' + 8 bytes (a hint), then 'K' (success) or 'E' + text (an Error).
 ChildRead::ChildRead(const std::string& path, const std::function<void(const std::function<void(uint64_t)>&)>& read)
     : path_(path) {
@@ -277,6 +290,7 @@ ChildRead::ChildRead(const std::string& path, const std::function<void(const std
     if (::pipe(fds) != 0) throw Error(path + ": cannot check the file (pipe failed)");
     std::cout.flush();
     std::cerr.flush();
+    waitForTbbWorkers();
     pid_ = ::fork();
     if (pid_ < 0) {
         ::close(fds[0]);
