@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <memory>
 
-#include "footprint/ellipsoid.h"
 #include "footprint/tables.h"
 #include "render/hybrid.h"
 #include "render/reference.h"
@@ -72,8 +71,6 @@ Camera cameraFor(const Volume& volume, const RenderSettings& settings) {
 bool everyVoxelMinified(const Volume& volume, const Camera& camera, double thresholdPx) {
     if (volume.indexBox.empty()) return false;
     const openvdb::CoordBBox& box = volume.indexBox;
-    const glm::dmat3 A(volume.indexToWorld);
-    const double largestAxis = volume.isotropic ? volume.voxelSize : singularValues(A).x;
     double zNear = INFINITY;
     for (int corner = 0; corner < 8; ++corner) {
         const glm::dvec3 idx(corner & 1 ? box.max().x() : box.min().x(), corner & 2 ? box.max().y() : box.min().y(),
@@ -81,7 +78,7 @@ bool everyVoxelMinified(const Volume& volume, const Camera& camera, double thres
         zNear = std::min(zNear, camera.toView(glm::dvec3(volume.indexToWorld * glm::dvec4(idx, 1.0))).z);
     }
     // The depth is linear over the box, so its least value is at a corner.
-    return zNear > 0.0 && largestAxis * camera.focal() / zNear < thresholdPx;
+    return zNear > 0.0 && volume.largestAxis() * camera.focal() / zNear < thresholdPx;
 }
 
 RenderSettings resolvedFor(const Volume& volume, const Camera& camera, RenderSettings settings) {

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <unistd.h>
 
+#include "footprint/ellipsoid.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 #include "volume/grid_transfer.h"
@@ -162,6 +163,10 @@ void initOpenVdb() {
         // metadata of their declared size, which checkVdbStructure bounds by the file.
         openvdb::Metadata::unregisterType(openvdb::io::DelayedLoadMetadata::staticTypeName());
     });
+}
+
+double Volume::largestAxis() const {
+    return isotropic ? voxelSize : singularValues(glm::dmat3(indexToWorld)).x;
 }
 
 void Volume::worldBounds(glm::dvec3& lo, glm::dvec3& hi) const {

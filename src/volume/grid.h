@@ -37,6 +37,9 @@ struct Volume {
 
     /// @brief World-space bounds of the active voxels' centres, widened by half a voxel.
     void worldBounds(glm::dvec3& lo, glm::dvec3& hi) const;
+    /// @brief The voxel's longest axis in world units (A's largest singular value; h for cubic
+    /// voxels): the spacing whose projection decides whether a voxel is a point.
+    double largestAxis() const;
 };
 
 /// @brief Calls openvdb::initialize() once (thread-safe, idempotent).

@@ -70,7 +70,7 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
     for (int s = 0; s < 4; ++s)
         diagonal = std::max(diagonal, glm::length(A * glm::dvec3(1.0, s & 1 ? -1.0 : 1.0, s & 2 ? -1.0 : 1.0)));
     blockHalfDiagonal_ = 0.5 * (kBlockDim - 1) * (volume_.isotropic ? std::sqrt(3.0) * volume_.voxelSize : diagonal);
-    largestAxis_ = volume_.isotropic ? volume_.voxelSize : singularValues(A).x;
+    largestAxis_ = volume_.largestAxis();
     collectBlocks();
 }
 

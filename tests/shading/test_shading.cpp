@@ -353,10 +353,16 @@ TEST(ShadingRender, EveryVoxelMinifiedAgainstBruteForce) {
         const bool all = everyVoxelMinified(v, camera, s.threshold);
         std::printf("  distance %-4g: largest projected spacing %.3f px, every voxel minified: %s\n", distance, largest,
                     all ? "yes" : "no");
-        if (all) EXPECT_LT(largest, s.threshold) << distance;
+        if (all) {
+            EXPECT_LT(largest, s.threshold) << distance;
+        }
         (all ? minified : notMinified)++;
-        if (distance == 8.0) EXPECT_TRUE(all);
-        if (distance <= 1.0) EXPECT_FALSE(all);
+        if (distance == 8.0) {
+            EXPECT_TRUE(all);
+        }
+        if (distance <= 1.0) {
+            EXPECT_FALSE(all);
+        }
     }
     EXPECT_GT(minified, 0);
     EXPECT_GT(notMinified, 0);
