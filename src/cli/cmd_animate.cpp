@@ -413,6 +413,9 @@ int runAnimate(const Args& args) {
         });
         o.settings.subpixels = o.settings.effectiveSubpixels(everyFrameMinified);
     }
+    // --lod-blend auto: frames of a path blend every level-of-detail passage, so that no block
+    // pops between two frames (a still image switches the first passage: RenderSettings).
+    if (!o.settings.lodBlend) o.settings.lodBlend = LodBlend::On;
 
     // What the frames are made of: --resume refuses a folder made otherwise.
     std::error_code canonicalEc;

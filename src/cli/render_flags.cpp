@@ -60,10 +60,11 @@ constexpr RenderFlag kRenderFlags[] = {
      "level of detail: points are merged into aggregates of 2^3, 4^3 or 8^3\n"
      "voxels (same total optical depth, centroid and spread) whose side\n"
      "projects to at most PX pixels, 0..64 (default 1.25; 0 turns it off)"},
-    {"--lod-blend", "on|off", kQuality,
-     "on (default): blocks pass from one level of detail to the next gradually,\n"
-     "so a zoom does not pop; off: they switch at once (cheaper at some far\n"
-     "views: still images)"},
+    {"--lod-blend", "auto|on|off|still", kQuality,
+     "how blocks pass from one level of detail to the next. on: gradually, so\n"
+     "a zoom does not pop; off: at once; still: voxels become 2^3 cells at\n"
+     "once, later levels blend (closer and up to 6x cheaper for still images).\n"
+     "auto (default): on for animate, still otherwise"},
     {"--footprint", "P", kQuality,
      "auto (default): the (i, alpha) reindex table, and the exact ray-centre\n"
      "distance for splats far off the axis where the affine index is off;\n"
@@ -215,10 +216,7 @@ RenderSettings settingsFromFlags(const Args& args) {
     if (auto v = args.get("--kernel")) s.kernel = KernelShape::named(*v).id();
     applyFilterFlags(args, s);
     if (auto v = args.get("--lod")) s.lodPx = parseDouble(*v, "--lod");
-    if (auto v = args.get("--lod-blend")) {
-        if (*v != "on" && *v != "off") throw Error("--lod-blend: expected 'on' or 'off', got '" + *v + "'");
-        s.lodBlend = *v == "on";
-    }
+    if (auto v = args.get("--lod-blend")) s.lodBlend = parseLodBlend(*v);
     if (auto v = args.get("--compositing")) s.compositing = parseCompositingOrder(*v);
     if (auto v = args.get("--slab-thickness")) s.slabThickness = parseDouble(*v, "--slab-thickness");
     if (auto v = args.get("--simd")) {

@@ -60,7 +60,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     // bounds still narrow it; windows split only at slab boundaries, so the image is the same).
     streamOptions.slabsPerWindow = int(std::lround(streamOptions.slabsPerWindow / streamOptions.slabThickness));
     streamOptions.lodCellPx = pass.lodPx;
-    streamOptions.lodBlend = settings.lodBlend;
+    streamOptions.lodBlend = settings.effectiveLodBlend();
     streamOptions.pointPrefilterVariance = pass.lodPrefilterVariance;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point ? INFINITY
                                  : drawsOnlySplats(settings.mode)   ? 0.0

@@ -101,6 +101,18 @@ std::optional<CompositingOrder> parseCompositingOrder(const std::string& name) {
     throw Error("--compositing: expected 'auto', 'kernels' or 'slabs', got '" + name + "'");
 }
 
+std::optional<LodBlend> parseLodBlend(const std::string& name) {
+    if (name == "auto") return std::nullopt;
+    if (name == "on") return LodBlend::On;
+    if (name == "off") return LodBlend::Off;
+    if (name == "still") return LodBlend::Still;
+    throw Error("--lod-blend: expected 'auto', 'on', 'off' or 'still', got '" + name + "'");
+}
+
+std::string toString(LodBlend blend) {
+    return blend == LodBlend::On ? "on" : blend == LodBlend::Off ? "off" : "still";
+}
+
 std::string toString(CompositingOrder order) { return order == CompositingOrder::Slabs ? "slabs" : "kernels"; }
 
 nlohmann::json RenderSettings::toJson() const {
@@ -134,7 +146,7 @@ nlohmann::json RenderSettings::toJson() const {
     else j["subpixels"] = subpixels;
     j["show_primitives"] = showPrimitives;
     j["lod"] = mode == RenderMode::None ? 0.0 : lodPx;
-    if (!lodBlend) j["lod_blend"] = false;  // absent when on: default outputs unchanged
+    if (mode != RenderMode::Reference && mode != RenderMode::None) j["lod_blend"] = toString(effectiveLodBlend());
     if (effectiveCompositing() != CompositingOrder::Kernels && mode != RenderMode::Reference)
         j["compositing"] = toString(effectiveCompositing());  // absent for kernels: unshaded outputs unchanged
     if (effectiveSlabThickness() != 1.0 && mode != RenderMode::Reference) j["slab_thickness"] = effectiveSlabThickness();

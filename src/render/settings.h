@@ -55,6 +55,11 @@ std::string toString(FilterOrder order);
 std::optional<CompositingOrder> parseCompositingOrder(const std::string& name);
 std::string toString(CompositingOrder order);
 
+/// @brief `auto` (nullopt: RenderSettings::effectiveLodBlend decides), `on`, `off` or `still`.
+/// @throw Error "--lod-blend: expected 'auto', 'on', 'off' or 'still', got '<name>'".
+std::optional<LodBlend> parseLodBlend(const std::string& name);
+std::string toString(LodBlend blend);
+
 /// Postfilter: sub-pixels per axis. kAutoSubpixels (`--subpixels auto`, the default) lets
 /// RenderSettings::effectiveSubpixels decide per view; kMaxSubpixels is the most --subpixels accepts.
 /// k = 1 with a small V_s already reaches 45–60 dB on the tubes at the cost of the prefilter
@@ -117,10 +122,15 @@ struct RenderSettings {
     /// cap the spread a cell adds beside the points' filter decides (kLodMaxSpreadRatio,
     /// volume/stream.h), so an 8³ cell of 0.15 px voxels is not (docs/performance.md, session 3).
     double lodPx = 1.25;
-    /// Level of detail blended from one level to the next as the camera moves (no pop in a zoom;
-    /// volume/stream.h kLodPassage); false: each block switches at once where a level becomes
-    /// admissible (cheaper where blocks pass from voxels to 2³ cells; for still images).
-    bool lodBlend = true;
+    /// How blocks pass from one level of detail to the next (volume/stream.h LodBlend, kLodPassage):
+    /// On, blended as the camera moves (no pop in a zoom); Off, each block switches at once where a
+    /// level becomes admissible; Still, the first passage (voxels → 2³) switches, the later blend.
+    /// Unset (`--lod-blend auto`, the default): effectiveLodBlend() decides.
+    std::optional<LodBlend> lodBlend;
+    /// The rule used: as set, else Still. `animate` sets On for its frames when unset, so a zoom
+    /// never pops; a still image gains nothing from the first passage's blend (docs/performance.md,
+    /// session 8: the same or closer to the reference, and up to 6× faster where blocks are in it).
+    LodBlend effectiveLodBlend() const { return lodBlend.value_or(LodBlend::Still); }
     /// Forward modes: each kernel composited whole at its depth (Kernels, DESIGN §4), or every
     /// kernel's optical depth spread over the radial slabs it spans and each slab composited
     /// once (Slabs; composite/compositing.h, docs/compositing.md). The reference ignores it.

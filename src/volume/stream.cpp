@@ -182,7 +182,11 @@ void VoxelStream::lodLevel(Block& b) const {
     const double bySize = std::log2(options_.lodCellPx / spacingPx);
     const double bySpread = 0.5 * std::log2(1.0 + 12.0 * kLodMaxSpreadRatio * filter / (spacingPx * spacingPx));
     const double ell = std::min(bySize, bySpread);
-    if (!options_.lodBlend) {  // the level switches at once where it becomes admissible
+    // The level switches at once where it becomes admissible: everywhere (Off), or in the first
+    // passage (Still: from ℓ = 1 the block is 2³ cells, which meets the blended rule at ℓ = 1.75).
+    const bool switching = options_.lodBlend == LodBlend::Off ||
+                           (options_.lodBlend == LodBlend::Still && ell < kLodPassage[0].second);
+    if (switching) {
         if (ell >= 1.0) b.lodLevel = int(std::min(std::floor(ell), 3.0));
         return;
     }

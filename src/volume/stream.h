@@ -76,6 +76,21 @@ inline constexpr double kLodMaxSpreadRatio = 0.75;
 /// switching rule's records plus those of its lighter level (docs/performance.md, session 5).
 inline constexpr std::pair<double, double> kLodPassage[3] = {{1.0, 1.75}, {1.75, 2.0}, {2.25, 3.0}};
 
+/// How a block passes from one level of detail to the next as its ℓ grows (kLodPassage).
+enum class LodBlend : uint8_t {
+    /// Every passage blended: no cell pops during a zoom (`animate`'s default).
+    On,
+    /// Every level switches at once where it becomes admissible (the rule before session 5).
+    Off,
+    /// The first passage switches at once (a block is 2³ cells from ℓ = 1), the later ones blend:
+    /// the default for still images. The first passage exists only so that a zoom does not pop;
+    /// a still image drawn there voxel by voxel is no closer to the reference (0 to −3.7 dB on the
+    /// fidelity table's far views) and costs up to 7.5× the points (the checker box at 1024²:
+    /// 712 372 against 94 328). The later passages do help still images (the far Engine loses
+    /// 1.08 dB without them), and cost at most the switching rule's records plus a lighter level's.
+    Still,
+};
+
 struct StreamOptions {
     double slabThickness = 1.0;  ///< slab thickness in voxels (points are summed within one slab)
     int slabsPerWindow = 8;      ///< a window is this many slabs (more when they are nearly empty)
@@ -93,11 +108,12 @@ struct StreamOptions {
     /// only while the spread a cell adds stays within kLodMaxSpreadRatio of the variance of the
     /// points it replaces (pointFilterVariance with the pass's low-pass below).
     double lodCellPx = 1.0;
-    /// Level of detail, blended (docs/performance.md, "Level of detail"): a block passes from one
-    /// level to the next continuously as the camera moves, drawn at both with its optical depth
-    /// split between them, so no cell pops during a zoom; false: the level switches at once where
-    /// it becomes admissible (the rule before session 5; `--lod-blend off`, RenderSettings::lodBlend).
-    bool lodBlend = true;
+    /// Level of detail, blended (docs/performance.md, "Level of detail"): On, a block passes from
+    /// one level to the next continuously as the camera moves, drawn at both with its optical depth
+    /// split between them, so no cell pops during a zoom; Off, the level switches at once where
+    /// it becomes admissible (the rule before session 5); Still, the first passage switches and the
+    /// later ones blend (`--lod-blend`, RenderSettings::effectiveLodBlend).
+    LodBlend lodBlend = LodBlend::On;
     /// Blended, voxels → 2³: each 2³ cell passes over this fraction of its block's passage, placed
     /// by a hash of the cell, so only that fraction of a passing block is drawn twice (1: all).
     double lodVoxelRamp = 0.1;

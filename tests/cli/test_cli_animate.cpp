@@ -118,6 +118,8 @@ TEST_F(AnimateCli, AutoSubpixelsAreFixedForThePath) {
         ASSERT_EQ(r.rc, 0) << r.err;
         const nlohmann::json record = nlohmann::json::parse(slurp(dir + "/animation.json"));
         EXPECT_EQ(record.at("settings").at("subpixels"), c.k) << c.name;
+        // --lod-blend auto: a path blends every level-of-detail passage (no pop between frames).
+        EXPECT_EQ(record.at("settings").at("lod_blend"), "on") << c.name;
     }
 }
 

@@ -501,6 +501,22 @@ TEST_F(CliRender, StatsJsonEchoesTheSubpixelsUsed) {
     }
 }
 
+// --lod-blend auto is Still for a still image; the rule used is echoed, and every value parses.
+TEST_F(CliRender, StatsJsonEchoesTheLevelBlend) {
+    const fs::path d = runDir("stats-lod-blend");
+    for (const auto& [given, used] : std::vector<std::pair<std::string, std::string>>{
+             {"", "still"}, {"auto", "still"}, {"on", "on"}, {"off", "off"}, {"still", "still"}}) {
+        const std::string name = given.empty() ? "default" : given;
+        const fs::path stats = d / "out" / (name + ".json");
+        std::vector<std::string> flags = {"--distance", "8", "--size", "48x48", "--stats", stats.string()};
+        if (!given.empty()) flags.insert(flags.end(), {"--lod-blend", given});
+        const Result r = runBinary(renderArgs(vdb("sphere.vdb"), (d / "out" / (name + ".png")).string(), "hybrid", flags),
+                                   d / "log");
+        ASSERT_EQ(r.rc, 0) << name << ": " << r.err;
+        EXPECT_EQ(nlohmann::json::parse(slurp(stats))["lod_blend"], used) << name;
+    }
+}
+
 TEST_F(CliRender, StatsJsonHasCountsTimingsAndSettings) {
     const fs::path d = runDir("stats");
     const fs::path stats = d / "out" / "s.json";

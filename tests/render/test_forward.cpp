@@ -329,7 +329,9 @@ TEST(Forward, ZoomThroughTheSwitchDoesNotPop) {
     for (int k = 0; k < kFrames; ++k) {
         const double distance = 2.2 * std::pow(0.65 / 2.2, double(k) / (kFrames - 1));
         RenderStats st;
-        const Image hybrid = renderWith(marschnerLobb(), tf, settingsFor(RenderMode::Hybrid, distance), &st);
+        RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        s.lodBlend = LodBlend::On;  // as animate draws a zoom (a still image makes 2³ cells at once)
+        const Image hybrid = renderWith(marschnerLobb(), tf, s, &st);
         const Image splat = renderWith(marschnerLobb(), tf, settingsFor(RenderMode::Splat, distance));
         const double fraction = double(st.splats) / double(std::max<uint64_t>(1, st.splats + st.points));
         (k == 0 ? first : last) = fraction;
@@ -389,9 +391,10 @@ TEST(Forward, LevelOfDetailBlendCanBeTurnedOff) {
     int fewer = 0;
     for (const double distance : {3.0, 5.0, 6.0, 8.0, 12.0}) {
         RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        s.lodBlend = LodBlend::On;
         RenderStats blended, switching;
         const Image a = renderWith(marschnerLobb(), tf, s, &blended);
-        s.lodBlend = false;
+        s.lodBlend = LodBlend::Off;
         const Image b = renderWith(marschnerLobb(), tf, s, &switching);
         const double psnr = compareImages(a, b).psnr;
         std::printf("  distance %.0f: blended %llu points, switching %llu points, %.1f dB apart\n", distance,
@@ -427,10 +430,15 @@ TEST(Forward, LevelOfDetailKeepsTheEnergy) {
 TEST(Forward, LevelOfDetailAggregatesHalfPixelVoxels) {
     const TransferFunction tf = TransferFunction::preset("grey");
     RenderSettings s = settingsFor(RenderMode::Hybrid, 2.0);  // 96²: Marschner–Lobb voxels at ≈ 0.55 px
-    RenderStats on, switching, off;
+    RenderStats on, switching, off, still;
+    const Image still0 = renderWith(marschnerLobb(), tf, s, &still);  // the default: Still
+    s.lodBlend = LodBlend::On;
     const Image a = renderWith(marschnerLobb(), tf, s, &on);
-    s.lodBlend = false;
+    s.lodBlend = LodBlend::Off;
     const Image c = renderWith(marschnerLobb(), tf, s, &switching);
+    // Every block is in the first passage (ℓ ≈ 1.2): a still image switches it, bit for bit.
+    EXPECT_TRUE(still0.pixels == c.pixels);
+    EXPECT_EQ(still.points, switching.points);
     s.lodPx = 0.0;
     const Image b = renderWith(marschnerLobb(), tf, s, &off);
     s.mode = RenderMode::Reference;
@@ -461,6 +469,7 @@ TEST(Forward, ZoomThroughTheLevelsDoesNotPop) {
     for (int k = 0; k < kFrames; ++k) {
         const double distance = 24.0 * std::pow(1.2 / 24.0, double(k) / (kFrames - 1));
         RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        s.lodBlend = LodBlend::On;  // as animate draws a zoom
         RenderStats st;
         const Image lod = renderWith(marschnerLobb(), tf, s, &st);
         s.lodPx = 0.0;
@@ -496,9 +505,10 @@ TEST(Forward, ZoomStepsAcrossLevelChangesAreSmooth) {
     struct Frame { Image blended, switching, none; };
     const auto frameAt = [&](double distance) {
         RenderSettings s = settingsFor(RenderMode::Hybrid, distance);
+        s.lodBlend = LodBlend::On;  // as animate draws a zoom
         Frame f;
         f.blended = renderWith(marschnerLobb(), tf, s);
-        s.lodBlend = false;
+        s.lodBlend = LodBlend::Off;
         f.switching = renderWith(marschnerLobb(), tf, s);
         s.lodPx = 0.0;
         f.none = renderWith(marschnerLobb(), tf, s);

@@ -233,7 +233,7 @@ TEST(Stream, AggregatesMatchBruteForceMoments) {
         const int level = 1 + run / 2, side = 1 << level;  // every level twice: vectorised sums, scalar sums
         StreamOptions o;
         o.vectorLeafMoments = run % 2 == 0;
-        o.lodBlend = false;
+        o.lodBlend = LodBlend::Off;
         o.pointBelowPx = INFINITY;
         o.lodCellPx = (side + 0.5) * spacing * 1.02;  // admits 2^level, not 2^(level+1)
         o.pointPrefilterVariance = 1.0;
@@ -306,7 +306,7 @@ TEST(Stream, BlendedLevelsKeepTheEnergy) {
     uint64_t voxelCount = 0;
     for (auto it = grid->tree().cbeginValueOn(); it; ++it) voxelMass += table(*it).sigma, ++voxelCount;
     struct Drawn { double mass = 0.0; uint64_t members = 0, records = 0; };
-    const auto draw = [&](double distance, bool blend) {
+    const auto draw = [&](double distance, LodBlend blend) {
         const Camera camera({-300.0 * distance, -200.0 * distance, 500.0 * distance}, {8.0, 8.0, 8.0}, {0.0, 0.0, 1.0},
                             30.0, 64, 64);
         StreamOptions o;
@@ -322,17 +322,25 @@ TEST(Stream, BlendedLevelsKeepTheEnergy) {
         return d;
     };
     // Voxel spacing from ≈ 0.8 px (no aggregate) to ≈ 0.02 px (8³ cells): every passage.
-    int passing = 0;
+    int passing = 0, stillSwitched = 0, stillBlended = 0;
     for (double distance = 0.12; distance < 6.0; distance *= 1.17) {
-        const Drawn d = draw(distance, true);
+        const Drawn d = draw(distance, LodBlend::On);
         EXPECT_NEAR(d.mass / voxelMass, 1.0, 2e-5) << "distance " << distance;
         EXPECT_EQ(d.members, voxelCount) << "distance " << distance;
-        const Drawn lo = draw(distance, false), hi = draw(distance * 2.0, false);
+        const Drawn lo = draw(distance, LodBlend::Off), hi = draw(distance * 2.0, LodBlend::Off);
+        // LodBlend::Still: the first passage switched (a block draws what Off draws), the later
+        // ones blended (what On draws); the energy and the voxel count kept either way.
+        const Drawn still = draw(distance, LodBlend::Still);
+        EXPECT_NEAR(still.mass / voxelMass, 1.0, 2e-5) << "distance " << distance;
+        EXPECT_EQ(still.members, voxelCount) << "distance " << distance;
+        EXPECT_LE(still.records, d.records) << "distance " << distance;
+        if (still.records == lo.records && still.records < d.records) ++stillSwitched;
+        if (still.records == d.records && still.records > lo.records) ++stillBlended;
         if (d.records != lo.records && d.records != hi.records) ++passing;
         // Past the first passage (ℓ ≥ 1.75: the switching rule aggregates at ℓ − 0.75 already),
         // blending costs at most the switching rule's records plus its lighter level's (an eighth
         // on this dense grid; a rule whose 2³ → 4³ passage ran past ℓ = 2 drew 9× there).
-        const Drawn before = draw(distance * std::exp2(-(kLodPassage[0].second - kLodPassage[0].first)), false);
+        const Drawn before = draw(distance * std::exp2(-(kLodPassage[0].second - kLodPassage[0].first)), LodBlend::Off);
         if (before.records * 4 <= voxelCount) {
             EXPECT_LE(double(d.records), 1.25 * double(lo.records)) << "distance " << distance;
         }
@@ -340,6 +348,8 @@ TEST(Stream, BlendedLevelsKeepTheEnergy) {
                     (unsigned long long)d.records, (unsigned long long)lo.records, (unsigned long long)hi.records);
     }
     EXPECT_GE(passing, 8);
+    EXPECT_GE(stillSwitched, 2);  // views in the first passage
+    EXPECT_GE(stillBlended, 2);   // views in a later one
 }
 
 }  // namespace
