@@ -18,6 +18,7 @@
 // The order inside a tile is a total order independent of threads, so the image
 // does not depend on the thread count.
 #pragma once
+#include <algorithm>
 #include <memory>
 #include <span>
 #include <vector>
@@ -70,11 +71,14 @@ public:
     /// @brief The same for primitives one by one (tests): packed into a ProjectedWindow first.
     SkippedPrimitives composite(std::span<const Primitive> prims, double& binSeconds, double& compositeSeconds);
 
-    /// @brief True if every pixel of the inclusive rectangle is already opaque (T < ε).
+    /// @brief True if every pixel of the inclusive rectangle (clamped to the image) is already
+    /// opaque (T < ε): tiles with no live pixel are passed whole, the others pixel by pixel, so a
+    /// block or primitive on the dead side of a tile that straddles a silhouette is caught too.
     bool hidden(int x0, int y0, int x1, int y1) const {
+        x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, width_ - 1), y1 = std::min(y1, height_ - 1);
         for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)
             for (int tx = x0 / kTileSize; tx <= x1 / kTileSize; ++tx)
-                if (liveCount_[size_t(ty) * tilesX_ + tx] > 0) return false;
+                if (liveCount_[size_t(ty) * tilesX_ + tx] > 0 && anyLive(tx, ty, x0, y0, x1, y1)) return false;
         return true;
     }
 
@@ -87,6 +91,17 @@ public:
     Image image() const;
 
 private:
+    /// Whether a pixel of tile (@p tx, @p ty) inside the inclusive rectangle has T ≥ ε.
+    bool anyLive(int tx, int ty, int x0, int y0, int x1, int y1) const {
+        const int ya = std::max(y0, ty * kTileSize), yb = std::min(y1, ty * kTileSize + kTileSize - 1);
+        const int xa = std::max(x0, tx * kTileSize), xb = std::min(x1, tx * kTileSize + kTileSize - 1);
+        for (int y = ya; y <= yb; ++y) {
+            const float* row = transmittance_.data() + size_t(y) * size_t(width_);
+            for (int x = xa; x <= xb; ++x)
+                if (row[x] >= kTransmittanceEpsilon) return true;
+        }
+        return false;
+    }
     struct Entry {
         uint64_t key;    // slab (relative) · kind · depth bits
         uint32_t index;  // primitive index: the tie-break

@@ -191,7 +191,7 @@ struct RenderStats {
     uint64_t culled = 0;              ///< active voxels that drew nothing (frustum, occlusion, off screen, σ = 0)
     uint64_t culledFrustum = 0;       ///< of those: in blocks outside the view frustum or behind the eye
     uint64_t culledOccluded = 0;      ///< ... in blocks behind opaque tiles, never classified or projected
-    uint64_t culledHidden = 0;        ///< ... projected, then dropped: every tile they touch was opaque
+    uint64_t culledHidden = 0;        ///< ... projected, then dropped: every pixel they touch was opaque (at projection: pixel by pixel; at binning: by tiles)
     uint64_t lodAggregates = 0;       ///< level-of-detail points drawn for aggregates of voxels
     uint64_t lodVoxels = 0;           ///< active voxels those aggregates stand for
     uint64_t windows = 0;             ///< forward modes: depth windows streamed

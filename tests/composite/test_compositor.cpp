@@ -256,6 +256,46 @@ TEST(TileCompositor, SameImageForAnyThreadCount) {
     ASSERT_EQ(one.pixels, two.pixels);
 }
 
+// hidden() (the occlusion test for blocks and primitives) against brute force over the image:
+// true exactly when every pixel of the rectangle, clamped to the image, has T < ε, including
+// rectangles on the opaque side of a tile that still has live pixels (a tile-level test says no).
+TEST(TileCompositor, HiddenIsExactPerPixel) {
+    const Camera camera = testCamera(72);
+    const auto windows = randomWindows(camera, RenderMode::Hybrid);
+    TileCompositor compositor(camera.width(), camera.height(), tables(), ExactContext{&camera, 0.1, true});
+    double bin = 0.0, comp = 0.0;
+    for (const auto& prims : windows) compositor.composite(prims, bin, comp);
+    const Image image = compositor.image();
+    const int w = camera.width(), h = camera.height();
+    const auto T = [&](int x, int y) { return 1.0 - double(image.pixels[size_t(y) * w + x].w); };
+    std::mt19937 rng(23);
+    std::uniform_int_distribution<int> corner(-6, 77), extent(0, 12);
+    int hidden = 0, hiddenInLiveTiles = 0, checked = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const int x0 = corner(rng), y0 = corner(rng), x1 = x0 + extent(rng), y1 = y0 + extent(rng);
+        bool all = true, ambiguous = false, liveTile = false;
+        for (int y = std::max(y0, 0); y <= std::min(y1, h - 1); ++y)
+            for (int x = std::max(x0, 0); x <= std::min(x1, w - 1); ++x) {
+                all = all && T(x, y) < kTransmittanceEpsilon;
+                ambiguous = ambiguous || std::abs(T(x, y) - kTransmittanceEpsilon) < 1e-6;  // alpha's rounding
+            }
+        if (ambiguous || x1 < 0 || y1 < 0 || x0 >= w || y0 >= h) continue;
+        // Does a tile under the rectangle hold a live pixel anywhere (outside the rectangle too)?
+        for (int ty = std::max(y0, 0) / kTileSize; ty <= std::min(y1, h - 1) / kTileSize; ++ty)
+            for (int tx = std::max(x0, 0) / kTileSize; tx <= std::min(x1, w - 1) / kTileSize; ++tx)
+                for (int y = ty * kTileSize; y < std::min(h, (ty + 1) * kTileSize); ++y)
+                    for (int x = tx * kTileSize; x < std::min(w, (tx + 1) * kTileSize); ++x)
+                        liveTile = liveTile || T(x, y) >= kTransmittanceEpsilon;
+        ++checked;
+        ASSERT_EQ(compositor.hidden(x0, y0, x1, y1), all) << x0 << "," << y0 << " .. " << x1 << "," << y1;
+        hidden += all;
+        hiddenInLiveTiles += all && liveTile;
+    }
+    std::printf("  %d rectangles: %d hidden, %d of them in tiles with live pixels\n", checked, hidden, hiddenInLiveTiles);
+    EXPECT_GT(hiddenInLiveTiles, 100);  // the case a tile-level test misses is exercised
+    EXPECT_LT(hidden, checked);
+}
+
 // projectBatch is projectVoxel over the batch, in order, with the window's slab and depth, packed
 // into the window's arrays (record, order key, depth, members, extra), and counted by kind.
 TEST(ProjectBatch, EqualsProjectVoxelOneByOne) {

@@ -372,7 +372,9 @@ TEST(Forward, LevelOfDetailKeepsTheFarImage) {
         EXPECT_EQ(off.lodAggregates, 0u);
         EXPECT_GT(on.lodAggregates, 0u);
         EXPECT_LT(on.points * 4, off.points);   // it did aggregate
-        EXPECT_EQ(on.culled, off.culled);       // and every voxel is still accounted for
+        // Every voxel is still accounted for: the same culled, but for those behind pixels already
+        // opaque (T < ε), which aggregates and voxels reach a little differently.
+        EXPECT_EQ(on.culled - on.culledHidden - on.culledOccluded, off.culled - off.culledHidden - off.culledOccluded);
         EXPECT_GT(psnr, 47.0);
         EXPECT_GT(lodToRef, noneToRef - 0.1);
     }
@@ -400,7 +402,10 @@ TEST(Forward, LevelOfDetailBlendCanBeTurnedOff) {
         std::printf("  distance %.0f: blended %llu points, switching %llu points, %.1f dB apart\n", distance,
                     (unsigned long long)blended.points, (unsigned long long)switching.points, psnr);
         EXPECT_LE(switching.points, blended.points) << "distance " << distance;
-        EXPECT_EQ(switching.culled, blended.culled);
+        // The same voxels culled, but for those behind opaque pixels (the two rules deposit a
+        // little differently, so a pixel may reach T < ε under one and not the other).
+        EXPECT_EQ(switching.culled - switching.culledHidden - switching.culledOccluded,
+                  blended.culled - blended.culledHidden - blended.culledOccluded);
         EXPECT_GT(psnr, 40.0) << "distance " << distance;
         if (switching.points < blended.points) ++fewer;
         EXPECT_TRUE(s.toJson().contains("lod_blend"));
