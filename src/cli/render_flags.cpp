@@ -63,7 +63,8 @@ constexpr RenderFlag kRenderFlags[] = {
     {"--lod-blend", "auto|on|off|still", kQuality,
      "how blocks pass from one level of detail to the next. on: gradually, so\n"
      "a zoom does not pop; off: at once; still: voxels become 2^3 cells at\n"
-     "once, later levels blend (closer and up to 6x cheaper for still images).\n"
+     "once, later levels blend (as close or closer, and up to 5.6x faster,\n"
+     "for still images).\n"
      "auto (default): on for animate, still otherwise"},
     {"--footprint", "P", kQuality,
      "auto (default): the (i, alpha) reindex table, and the exact ray-centre\n"

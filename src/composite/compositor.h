@@ -74,6 +74,7 @@ public:
     /// @brief True if every pixel of the inclusive rectangle (clamped to the image) is already
     /// opaque (T < ε): tiles with no live pixel are passed whole, the others pixel by pixel, so a
     /// block or primitive on the dead side of a tile that straddles a silhouette is caught too.
+    /// A rectangle wholly off the image covers no pixel, so it is hidden (it would draw nothing).
     bool hidden(int x0, int y0, int x1, int y1) const {
         x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, width_ - 1), y1 = std::min(y1, height_ - 1);
         for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)

@@ -87,7 +87,7 @@ enum class LodBlend : uint8_t {
     /// a still image drawn there voxel by voxel is no closer to the reference (0 to −3.7 dB on the
     /// fidelity table's far views) and costs up to 7.5× the points (the checker box at 1024²:
     /// 712 372 against 94 328). The later passages do help still images (the far Engine loses
-    /// 1.08 dB without them), and cost at most the switching rule's records plus a lighter level's.
+    /// 1.07 dB with them switched), and cost at most the switching rule's records plus a lighter level's.
     Still,
 };
 
