@@ -6,6 +6,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <cmath>
+#include <optional>
 
 #include "footprint/ellipse.h"
 #include "footprint/ellipsoid.h"
@@ -13,6 +14,7 @@
 #include "footprint/screen_kernel.h"
 #include "pointfilter/point_filter.h"
 #include "render/project_modes.h"
+#include "render/project_vector.h"
 
 namespace vdbsplat {
 
@@ -93,7 +95,10 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, const Pr
             p.scale = float(sigma * kernel.amplitude);  // σ·h·amplitude with σ per world unit = sigma/h
             p.sin2Alpha = float(sphere.sinAlpha * sphere.sinAlpha);  // sin α = r/D
             if (p.kind == PrimitiveKind::SplatExactIndex) {
-                p.exactMap = makeExactIndexMap(kernel, sphere, PixelCoord(p.centre));  // δ from the float centre the loop uses
+                // δ from the kernel's own (double) centre: the float centre the loop measures from
+                // differs by < 2⁻²⁴ of it (g++ 12 folded the round trip through float away here, so
+                // this was already the map; stated, so that every compiler makes the same one).
+                p.exactMap = makeExactIndexMap(kernel, sphere, kernel.centre);
                 p.hasExactMap = true;
             }
             p.range = pixelRange(kernel.bounds, ctx.camera.width(), ctx.camera.height());
@@ -139,6 +144,23 @@ Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, const ProjectionC
     return p;
 }
 
+/// makeSplat's primitive from lane @p k of a projectSplatsVector call (the same fields).
+Primitive splatFromLane(const SplatLanes& lanes, size_t k, const glm::vec3& viewPos, float sigma, const glm::vec3& color,
+                        const ProjectionContext& ctx) {
+    Primitive p;
+    p.viewPos = viewPos;
+    p.sigma = sigma;
+    p.kind = lanes.status[k] == SplatLanes::kExactIndex ? PrimitiveKind::SplatExactIndex : PrimitiveKind::Splat;
+    p.centre = glm::vec2(float(lanes.centreX[k]), float(lanes.centreY[k]));
+    p.conic = glm::vec3(float(lanes.conicXX[k]), float(lanes.conicXY[k]), float(lanes.conicYY[k]));
+    p.scale = float(sigma * lanes.amplitude[k]);
+    p.sin2Alpha = float(lanes.sinAlpha[k] * lanes.sinAlpha[k]);
+    if (p.kind == PrimitiveKind::SplatExactIndex) p.exactMap = lanes.exactMap(k), p.hasExactMap = true;
+    p.range = lanes.range(k);
+    p.color = ctx.showPrimitives ? splatTint(color) : color;
+    return p;
+}
+
 }  // namespace
 
 Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx,
@@ -177,16 +199,50 @@ SlabProfile slabProfileFor(const glm::dvec3& c, double distance, int64_t slab, f
                         : slabFractions(kernel, offset, unit / ctx.slabLength, ctx.slabs.reach, lowest);
 }
 
+std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx) {
+    if (!ctx.vector || (ctx.shape && !ctx.shape->sphere) || ctx.footprint == FootprintPath::Exact) return std::nullopt;
+    if (ctx.mode != RenderMode::Hybrid && ctx.mode != RenderMode::Splat) return std::nullopt;
+    SplatLaneContext lanes;
+    lanes.focal = ctx.camera.focal();
+    lanes.principalX = ctx.camera.principal().x, lanes.principalY = ctx.camera.principal().y;
+    lanes.radius = ctx.tables.kernel->radius() * ctx.voxelSize;  // makeSplat's sphere
+    const double toSupport = ctx.tables.kernel->radius() / ctx.tables.kernel->sigma();  // makeScreenKernel
+    lanes.widen = toSupport * toSupport * std::max(ctx.prefilterVariance, 0.0);
+    lanes.spacingTimesFocal = ctx.voxelSize * ctx.camera.focal();
+    lanes.threshold = ctx.threshold;
+    lanes.pointsBelow = ctx.mode == RenderMode::Hybrid;
+    lanes.autoExactIndex = ctx.footprint == FootprintPath::Auto;
+    lanes.exactIndexError = kAutoExactIndexError;
+    lanes.width = ctx.camera.width(), lanes.height = ctx.camera.height();
+    const bool valid = lanes.radius > 0.0 && std::isfinite(lanes.radius) && lanes.focal > 0.0 && std::isfinite(lanes.focal) &&
+                       std::isfinite(lanes.principalX) && std::isfinite(lanes.principalY);
+    return valid ? std::optional(lanes) : std::nullopt;
+}
+
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window) {
     window.slabBase = batch.slabBegin;
     window.slabEnd = batch.slabEnd;
     window.profiles = ctx.slabs.on;
     window.resize(batch.size());
+    const std::optional<SplatLaneContext> laneContext = splatLaneContext(ctx);
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, batch.size(), 1024), ProjectionCounts{},
         [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
+            SplatLanes lanes;
+            size_t chunk = r.begin(), chunkEnd = r.begin();  // lanes hold voxels [chunk, chunkEnd)
             for (size_t i = r.begin(); i < r.end(); ++i) {
-                Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
+                if (laneContext && i == chunkEnd) {  // the next kSplatLanes voxels, projected at once
+                    chunk = i, chunkEnd = std::min(r.end(), i + kSplatLanes);
+                    for (size_t k = chunk; k < chunkEnd; ++k) {
+                        lanes.x[k - chunk] = batch.viewPos[k].x, lanes.y[k - chunk] = batch.viewPos[k].y;
+                        lanes.z[k - chunk] = batch.viewPos[k].z;
+                    }
+                    for (size_t k = chunkEnd - chunk; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
+                    projectSplatsVector(lanes, chunkEnd - chunk, *laneContext);
+                }
+                Primitive p = laneContext && lanes.status[i - chunk] != SplatLanes::kScalar
+                                  ? splatFromLane(lanes, i - chunk, batch.viewPos[i], batch.sigma[i], batch.color[i], ctx)
+                                  : projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
                 p.members = batch.members[i];
                 p.depth = batch.distance[i];
                 p.slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,

@@ -5,6 +5,7 @@
 // the near-eye fallback (footprint/ellipse.h). Runs in parallel; primitive i
 // always comes from voxel i, so the order stays deterministic.
 #pragma once
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "footprint/ellipsoid.h"
 #include "footprint/prefilter.h"
 #include "footprint/tables.h"
+#include "render/project_vector.h"
 #include "render/settings.h"
 #include "volume/stream.h"
 
@@ -68,6 +70,12 @@ struct ProjectionCounts {
         return *this;
     }
 };
+
+/// @brief What projectSplatsVector (render/project_vector.h) needs of @p ctx, where it applies:
+/// sphere kernels in hybrid or splat-only mode, --simd on (ctx.vector), the footprint not `exact`
+/// (whose splats are recomputed per tile), and a camera projectSphere accepts. nullopt: every
+/// voxel takes projectVoxel. projectBatch projects through it, lanes it declines through projectVoxel.
+std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx);
 
 /// @brief Projects every voxel of @p batch into @p window (grown when needed, never shrunk: it
 /// is reused window after window): primitive i from voxel i (projectVoxel), with the voxel's

@@ -1,0 +1,61 @@
+// render/project_vector.h — the projection's common case, many voxels at once.
+// Owns: projectSplatsVector, which projects up to kSplatLanes voxel centres as sphere-kernel
+// splats in double precision with Google Highway (runtime dispatch: SSE4, AVX2, AVX-512 … one
+// binary): the exact ellipse of the kernel sphere (projectSphere, DESIGN §2), the conic widened
+// by the low-pass (makeScreenKernel), its pixel range (pixelRange), the affine-index error that
+// picks --footprint auto's exact index, and that index's map (makeExactIndexMap). The same
+// operations in the same order, without fused multiply-adds, so the same values bit for bit as
+// the scalar functions (the oracle; tests/render/test_project_vector.cpp). Lanes the common case
+// does not cover (behind or at the eye, straddling the eye plane, a point in hybrid, non-finite,
+// no pixel on the image) are marked for the scalar path, which decides them as before.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <glm/glm.hpp>
+
+#include "footprint/pixel_box.h"
+#include "footprint/screen_kernel.h"
+
+namespace vdbsplat {
+
+/// Voxels per call: a chunk of projectBatch's range (its arrays live on the stack).
+inline constexpr size_t kSplatLanes = 64;
+
+/// What every lane shares: the camera, the kernel and the rules (from ProjectionContext).
+struct SplatLaneContext {
+    double focal = 1.0;               ///< f (pixels)
+    double principalX = 0.0, principalY = 0.0;
+    double radius = 0.0;              ///< the kernel sphere's radius r = R·h (world units)
+    double widen = 0.0;               ///< (R/s_g)²·V_h: the low-pass on the support semi-axes² (px²)
+    double spacingTimesFocal = 0.0;   ///< h·f: the projected spacing is h·f/z
+    double threshold = 0.0;           ///< hybrid: a splat where h·f/z ≥ threshold; ignored when !pointsBelow
+    bool pointsBelow = true;          ///< hybrid (points below the threshold); false: every voxel a splat
+    bool autoExactIndex = true;       ///< --footprint auto: exact index where the affine error > kAutoExactIndexError
+    double exactIndexError = 5e-4;    ///< that bound (render/project.h, kAutoExactIndexError)
+    int width = 0, height = 0;        ///< image size (pixels)
+};
+
+/// One call's lanes, structure of arrays. In: x, y, z (view space). Out, per lane: `status`
+/// kScalar (the scalar path decides), kSplat or kExactIndex, and for those the splat's fields.
+struct SplatLanes {
+    static constexpr uint8_t kScalar = 0, kSplat = 1, kExactIndex = 2;
+    alignas(64) double x[kSplatLanes], y[kSplatLanes], z[kSplatLanes];
+    // Out, in double (the scalar path's values; the caller rounds to the float fields).
+    alignas(64) double amplitude[kSplatLanes];  ///< √(det V / det V'): scale = σ·amplitude
+    alignas(64) double centreX[kSplatLanes], centreY[kSplatLanes];
+    alignas(64) double conicXX[kSplatLanes], conicXY[kSplatLanes], conicYY[kSplatLanes];
+    alignas(64) double sinAlpha[kSplatLanes];
+    alignas(64) double x0[kSplatLanes], y0[kSplatLanes], x1[kSplatLanes], y1[kSplatLanes];  ///< integers
+    /// kExactIndex: the map's 19 values (v0, vx, vy, A, B, C as xyz, then 1/r²), lane by lane.
+    alignas(64) double map[19][kSplatLanes];
+    uint8_t status[kSplatLanes];
+
+    PixelRange range(size_t i) const { return {int(x0[i]), int(y0[i]), int(x1[i]), int(y1[i])}; }
+    ExactIndexMap exactMap(size_t i) const;
+};
+
+/// @brief Projects lanes [0, @p n) of @p lanes (n ≤ kSplatLanes; x, y, z set), writing their
+/// status and, where the common case holds, the splat (see the file comment).
+void projectSplatsVector(SplatLanes& lanes, size_t n, const SplatLaneContext& ctx);
+
+}  // namespace vdbsplat

@@ -1,0 +1,174 @@
+// tests/render/test_project_vector.cpp — the vector splat projection (render/project_vector.h)
+// against projectVoxel, its scalar oracle: every lane it takes must give the very primitive
+// projectVoxel gives (bit for bit), and it must take exactly the lanes that are on-image splats
+// of the sphere kernel, in every mode and footprint path it serves, near and far, on and off the
+// axis, at the eye plane, behind the eye, off the image and non-finite.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "footprint/tables.h"
+#include "render/project.h"
+#include "render/project_vector.h"
+
+namespace vdbsplat {
+namespace {
+
+const Tables& tables() {
+    static const Tables t = buildTables();
+    return t;
+}
+
+Camera testCamera(int size) {
+    CameraSpec spec;
+    spec.width = spec.height = size;
+    return makeCamera(spec, glm::dvec3(-8.0), glm::dvec3(8.0));
+}
+
+/// Voxel centres of every kind the projection meets (h = 0.1, kernel radius 0.2; f ≈ 119 px at 64 px).
+std::vector<glm::vec3> testVoxels() {
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    std::vector<glm::vec3> v;
+    for (int i = 0; i < 6000; ++i) {
+        const float z = -1.f + 45.f * u(rng) * u(rng);  // many near: large, off-axis splats
+        const float spread = 0.7f * std::max(std::abs(z), 0.3f);  // a little past the frustum's edges
+        v.emplace_back((u(rng) - 0.5f) * spread, (u(rng) - 0.5f) * spread, z);
+    }
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    for (const float z : {0.05f, 0.19f, 0.2f, 0.21f, 0.4f, 1.f, 30.f}) v.emplace_back(0.f, 0.f, z);  // on the axis
+    for (const float z : {0.2f, 0.2000001f, 0.25f}) v.emplace_back(0.3f, 0.f, z);                  // at the eye plane
+    v.emplace_back(0.f, 0.f, 0.f);
+    v.emplace_back(0.f, 0.f, -5.f);
+    v.emplace_back(nan, 0.f, 3.f);
+    v.emplace_back(0.f, inf, 3.f);
+    v.emplace_back(0.f, 0.f, inf);
+    v.emplace_back(1e30f, 1e30f, 1e30f);
+    return v;
+}
+
+struct Coverage {
+    int splats = 0, exact = 0, declined = 0;
+};
+
+void checkLanes(const ProjectionContext& ctx, const std::vector<glm::vec3>& voxels, Coverage& cov) {
+    const std::optional<SplatLaneContext> lc = splatLaneContext(ctx);
+    ASSERT_TRUE(lc.has_value());
+    SplatLanes lanes;
+    for (size_t begin = 0; begin < voxels.size(); begin += kSplatLanes) {
+        const size_t n = std::min(kSplatLanes, voxels.size() - begin);
+        for (size_t k = 0; k < n; ++k)
+            lanes.x[k] = voxels[begin + k].x, lanes.y[k] = voxels[begin + k].y, lanes.z[k] = voxels[begin + k].z;
+        projectSplatsVector(lanes, n, *lc);
+        for (size_t k = 0; k < n; ++k) {
+            const glm::vec3 c = voxels[begin + k];
+            const Primitive q = projectVoxel(glm::dvec3(c), 0.7f, glm::vec3(0.2f, 0.5f, 0.9f), ctx);
+            const bool splat = (q.kind == PrimitiveKind::Splat || q.kind == PrimitiveKind::SplatExactIndex) && !q.range.empty();
+            const uint8_t status = lanes.status[k];
+            ASSERT_EQ(status != SplatLanes::kScalar, splat) << "voxel " << c.x << ", " << c.y << ", " << c.z;
+            if (!splat) {
+                ++cov.declined;
+                continue;
+            }
+            ++(status == SplatLanes::kExactIndex ? cov.exact : cov.splats);
+            ASSERT_EQ(q.kind, status == SplatLanes::kExactIndex ? PrimitiveKind::SplatExactIndex : PrimitiveKind::Splat);
+            ASSERT_EQ(q.centre, glm::vec2(float(lanes.centreX[k]), float(lanes.centreY[k])));
+            ASSERT_EQ(q.conic, glm::vec3(float(lanes.conicXX[k]), float(lanes.conicXY[k]), float(lanes.conicYY[k])));
+            ASSERT_EQ(q.scale, float(0.7f * lanes.amplitude[k]));
+            ASSERT_EQ(q.sin2Alpha, float(lanes.sinAlpha[k] * lanes.sinAlpha[k]));
+            const PixelRange r = lanes.range(k);
+            ASSERT_TRUE(r.x0 == q.range.x0 && r.y0 == q.range.y0 && r.x1 == q.range.x1 && r.y1 == q.range.y1);
+            if (status == SplatLanes::kExactIndex) {
+                const ExactIndexMap m = lanes.exactMap(k);
+                ASSERT_EQ(m.v0, q.exactMap.v0);
+                ASSERT_EQ(m.vx, q.exactMap.vx);
+                ASSERT_EQ(m.vy, q.exactMap.vy);
+                ASSERT_EQ(m.A, q.exactMap.A);
+                ASSERT_EQ(m.B, q.exactMap.B);
+                ASSERT_EQ(m.C, q.exactMap.C);
+                ASSERT_EQ(m.invR2, q.exactMap.invR2);
+            }
+        }
+    }
+}
+
+TEST(ProjectVector, LanesEqualTheScalarProjection) {
+    const Camera camera = testCamera(64);
+    const std::vector<glm::vec3> voxels = testVoxels();
+    for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Splat})
+        for (const FootprintPath footprint : {FootprintPath::Auto, FootprintPath::Table})
+            for (const double prefilter : {kPrefilterVariance, 0.1, 0.0}) {
+                ProjectionContext ctx{camera, tables(), 0.1, 0.1, mode, 1.0, footprint, false, prefilter};
+                SCOPED_TRACE(toString(mode) + " prefilter " + std::to_string(prefilter));
+                Coverage cov;
+                checkLanes(ctx, voxels, cov);
+                // Both kinds, and every class the scalar path keeps, occur.
+                if (footprint == FootprintPath::Auto) {  // near the axis the affine index, off it the exact one
+                    EXPECT_GT(cov.splats, 5);
+                    EXPECT_GT(cov.exact, 300);
+                } else {
+                    EXPECT_GT(cov.splats, 300);
+                    EXPECT_EQ(cov.exact, 0);
+                }
+                EXPECT_GT(cov.declined, 300);
+            }
+}
+
+// A context the lanes do not serve takes the scalar path for every voxel.
+TEST(ProjectVector, OnlyServesSphereSplatsWithSimd) {
+    const Camera camera = testCamera(64);
+    ProjectionContext ctx{camera, tables(), 0.1, 0.1, RenderMode::Hybrid, 1.0, FootprintPath::Auto, false};
+    EXPECT_TRUE(splatLaneContext(ctx).has_value());
+    ctx.vector = false;
+    EXPECT_FALSE(splatLaneContext(ctx).has_value());
+    ctx.vector = true;
+    for (const RenderMode mode : {RenderMode::Point, RenderMode::Ewa, RenderMode::Swan, RenderMode::None}) {
+        ctx.mode = mode;
+        EXPECT_FALSE(splatLaneContext(ctx).has_value()) << toString(mode);
+    }
+    ctx.mode = RenderMode::Hybrid;
+    ctx.footprint = FootprintPath::Exact;
+    EXPECT_FALSE(splatLaneContext(ctx).has_value());
+}
+
+// projectBatch with the lanes and without (--simd off) fills the same window.
+TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
+    const Camera camera = testCamera(64);
+    const std::vector<glm::vec3> voxels = testVoxels();
+    VoxelBatch batch;
+    for (size_t i = 0; i < voxels.size(); ++i) {
+        batch.viewPos.push_back(voxels[i]);
+        batch.distance.push_back(std::isfinite(glm::length(voxels[i])) ? glm::length(voxels[i]) : 0.f);
+        batch.sigma.push_back(0.1f + float(i % 7));
+        batch.color.emplace_back(0.3f, float(i % 3) / 3.f, 1.f);
+        batch.spread.push_back(0.f);
+        batch.members.push_back(1 + uint32_t(i % 4));
+    }
+    batch.slabBegin = 0, batch.slabEnd = 1000;
+    ProjectionContext ctx{camera, tables(), 0.1, 0.1, RenderMode::Hybrid, 1.0, FootprintPath::Auto, false};
+    ProjectedWindow lanes, scalar;
+    const ProjectionCounts a = projectBatch(batch, ctx, lanes);
+    ctx.vector = false;
+    const ProjectionCounts b = projectBatch(batch, ctx, scalar);
+    EXPECT_EQ(a.points, b.points);
+    EXPECT_EQ(a.splats, b.splats);
+    EXPECT_EQ(a.exactIndexSplats, b.exactIndexSplats);
+    EXPECT_EQ(a.drawnVoxels, b.drawnVoxels);
+    ASSERT_EQ(lanes.size, scalar.size);
+    for (size_t i = 0; i < lanes.size; ++i) {
+        ASSERT_EQ(lanes.order[i], scalar.order[i]) << i;
+        if (lanes.order[i] == ProjectedWindow::kNotDrawn) continue;
+        const PrimitiveRecord &p = lanes.records[i], &q = scalar.records[i];
+        ASSERT_EQ(p.kind, q.kind) << i;
+        ASSERT_EQ(p.centre, q.centre) << i;
+        ASSERT_EQ(p.shape, q.shape) << i;
+        ASSERT_EQ(p.scale, q.scale) << i;
+        ASSERT_EQ(p.color, q.color) << i;
+        if (p.hasExactMap) ASSERT_EQ(lanes.extra[i].exactMap.A, scalar.extra[i].exactMap.A) << i;
+    }
+}
+
+}  // namespace
+}  // namespace vdbsplat
