@@ -150,13 +150,15 @@ Primitive splatFromLane(const SplatLanes& lanes, size_t k, const glm::vec3& view
     Primitive p;
     p.viewPos = viewPos;
     p.sigma = sigma;
-    p.kind = lanes.status[k] == SplatLanes::kExactIndex ? PrimitiveKind::SplatExactIndex : PrimitiveKind::Splat;
+    const uint8_t status = lanes.status[k];
+    p.kind = status & SplatLanes::kExactIndex ? PrimitiveKind::SplatExactIndex : PrimitiveKind::Splat;
     p.centre = glm::vec2(float(lanes.centreX[k]), float(lanes.centreY[k]));
     p.conic = glm::vec3(float(lanes.conicXX[k]), float(lanes.conicXY[k]), float(lanes.conicYY[k]));
     p.scale = float(sigma * lanes.amplitude[k]);
     p.sin2Alpha = float(lanes.sinAlpha[k] * lanes.sinAlpha[k]);
     if (p.kind == PrimitiveKind::SplatExactIndex) p.exactMap = lanes.exactMap(k), p.hasExactMap = true;
     p.range = lanes.range(k);
+    if (status & SplatLanes::kOffImage) p.kind = PrimitiveKind::Culled;
     p.color = ctx.showPrimitives ? splatTint(color) : color;
     return p;
 }

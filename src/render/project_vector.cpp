@@ -31,6 +31,10 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         // projectVoxel: in hybrid a point where h·f/z < threshold (z > 0 here).
         auto handled = hn::And(hn::And(hn::IsFinite(x), hn::IsFinite(y)), hn::And(hn::IsFinite(z), hn::Gt(z, zero)));
         if (ctx.pointsBelow) handled = hn::And(handled, hn::Not(hn::Lt(hn::Div(hf, z), threshold)));
+        if (hn::AllFalse(d, handled)) {  // all points (far views) or the scalar path's: nothing to do
+            for (size_t k = 0; k < N && i + k < n; ++k) L.status[i + k] = SplatLanes::kScalar;
+            continue;
+        }
         // projectSphere: D = |c| (glm: (x² + y²) + z²), ρ = √(x² + y²), sin α = r/D; an Ellipse
         // where D > r, not z ≤ r, and den = (z² − r²)/D² not below kMinDen.
         const V xx = hn::Mul(x, x), yy = hn::Mul(y, y), zz = hn::Mul(z, z);
@@ -82,7 +86,7 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         };
         const V x0 = first(hn::Sub(cx, hx), width), y0 = first(hn::Sub(cy, hy), height);
         const V x1 = last(hn::Add(cx, hx), width), y1 = last(hn::Add(cy, hy), height);
-        handled = hn::And(handled, hn::And(hn::Ge(x1, x0), hn::Ge(y1, y0)));  // a pixel on the image
+        const auto onImage = hn::And(hn::Ge(x1, x0), hn::Ge(y1, y0));  // else makeSplat culls it (no pixel)
         // affineIndexError: (ρ/z)·(r/√((D − r)(D + r))).
         const V error = hn::Mul(hn::Div(rho, z), hn::Div(r, hn::Sqrt(hn::Mul(hn::Sub(D, r), hn::Add(D, r)))));
         const auto exact = hn::And(hn::Gt(error, exactBound), hn::FirstN(d, ctx.autoExactIndex ? N : 0));
@@ -91,8 +95,9 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         hn::Store(qxx, d, L.conicXX + i), hn::Store(qxy, d, L.conicXY + i), hn::Store(qyy, d, L.conicYY + i);
         hn::Store(sinAlpha, d, L.sinAlpha + i);
         hn::Store(x0, d, L.x0 + i), hn::Store(y0, d, L.y0 + i), hn::Store(x1, d, L.x1 + i), hn::Store(y1, d, L.y1 + i);
-        // The lanes' status: 0 scalar, 1 splat, 2 exact index.
-        const V status = hn::IfThenElseZero(handled, hn::IfThenElse(exact, hn::Set(d, 2.0), one));
+        // The lanes' status: 0 scalar; else kSplat or kExactIndex, plus kOffImage.
+        const V kind = hn::IfThenElse(exact, hn::Set(d, double(SplatLanes::kExactIndex)), hn::Set(d, double(SplatLanes::kSplat)));
+        const V status = hn::IfThenElseZero(handled, hn::IfThenElse(onImage, kind, hn::Add(kind, hn::Set(d, double(SplatLanes::kOffImage)))));
         alignas(64) double st[HWY_MAX_BYTES / sizeof(double)];
         hn::Store(status, d, st);
         for (size_t k = 0; k < N && i + k < n; ++k) L.status[i + k] = uint8_t(st[k]);

@@ -6,8 +6,8 @@
 // picks --footprint auto's exact index, and that index's map (makeExactIndexMap). The same
 // operations in the same order, without fused multiply-adds, so the same values bit for bit as
 // the scalar functions (the oracle; tests/render/test_project_vector.cpp). Lanes the common case
-// does not cover (behind or at the eye, straddling the eye plane, a point in hybrid, non-finite,
-// no pixel on the image) are marked for the scalar path, which decides them as before.
+// does not cover (behind or at the eye, straddling the eye plane, a point in hybrid, non-finite)
+// are marked for the scalar path, which decides them as before.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -36,9 +36,10 @@ struct SplatLaneContext {
 };
 
 /// One call's lanes, structure of arrays. In: x, y, z (view space). Out, per lane: `status`
-/// kScalar (the scalar path decides), kSplat or kExactIndex, and for those the splat's fields.
+/// kScalar (the scalar path decides), or kSplat or kExactIndex, plus kOffImage where its range has
+/// no pixel (makeSplat then culls it, its fields computed all the same), and the splat's fields.
 struct SplatLanes {
-    static constexpr uint8_t kScalar = 0, kSplat = 1, kExactIndex = 2;
+    static constexpr uint8_t kScalar = 0, kSplat = 1, kExactIndex = 2, kOffImage = 4;
     alignas(64) double x[kSplatLanes], y[kSplatLanes], z[kSplatLanes];
     // Out, in double (the scalar path's values; the caller rounds to the float fields).
     alignas(64) double amplitude[kSplatLanes];  ///< √(det V / det V'): scale = σ·amplitude

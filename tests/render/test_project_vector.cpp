@@ -1,7 +1,7 @@
 // tests/render/test_project_vector.cpp — the vector splat projection (render/project_vector.h)
 // against projectVoxel, its scalar oracle: every lane it takes must give the very primitive
-// projectVoxel gives (bit for bit), and it must take exactly the lanes that are on-image splats
-// of the sphere kernel, in every mode and footprint path it serves, near and far, on and off the
+// projectVoxel gives (bit for bit), and it must take exactly the lanes whose kernel sphere
+// makeSplat projects to an ellipse (on the image or culled off it), in every mode and footprint path it serves, near and far, on and off the
 // axis, at the eye plane, behind the eye, off the image and non-finite.
 #include <gtest/gtest.h>
 
@@ -9,6 +9,8 @@
 #include <limits>
 #include <random>
 
+#include "footprint/ellipse.h"
+#include "footprint/kernel.h"
 #include "footprint/tables.h"
 #include "render/project.h"
 #include "render/project_vector.h"
@@ -50,7 +52,7 @@ std::vector<glm::vec3> testVoxels() {
 }
 
 struct Coverage {
-    int splats = 0, exact = 0, declined = 0;
+    int splats = 0, exact = 0, offImage = 0, declined = 0;
 };
 
 void checkLanes(const ProjectionContext& ctx, const std::vector<glm::vec3>& voxels, Coverage& cov) {
@@ -65,22 +67,33 @@ void checkLanes(const ProjectionContext& ctx, const std::vector<glm::vec3>& voxe
         for (size_t k = 0; k < n; ++k) {
             const glm::vec3 c = voxels[begin + k];
             const Primitive q = projectVoxel(glm::dvec3(c), 0.7f, glm::vec3(0.2f, 0.5f, 0.9f), ctx);
-            const bool splat = (q.kind == PrimitiveKind::Splat || q.kind == PrimitiveKind::SplatExactIndex) && !q.range.empty();
+            // makeSplat's ellipse: a splat (not a point in hybrid) whose sphere projects to an ellipse.
+            const double spacingPx = c.z > 0.f ? ctx.voxelSize * ctx.camera.focal() / double(c.z) : INFINITY;
+            const bool point = ctx.mode == RenderMode::Hybrid && spacingPx < ctx.threshold;
+            const bool ellipse = !point && projectSphere(ctx.camera, glm::dvec3(c), Kernel::kRadius * ctx.voxelSize).isEllipse();
             const uint8_t status = lanes.status[k];
-            ASSERT_EQ(status != SplatLanes::kScalar, splat) << "voxel " << c.x << ", " << c.y << ", " << c.z;
-            if (!splat) {
+            ASSERT_EQ(status != SplatLanes::kScalar, ellipse) << "voxel " << c.x << ", " << c.y << ", " << c.z;
+            if (!ellipse) {
                 ++cov.declined;
                 continue;
             }
-            ++(status == SplatLanes::kExactIndex ? cov.exact : cov.splats);
-            ASSERT_EQ(q.kind, status == SplatLanes::kExactIndex ? PrimitiveKind::SplatExactIndex : PrimitiveKind::Splat);
+            const bool exact = status & SplatLanes::kExactIndex;
+            if (status & SplatLanes::kOffImage) {
+                ++cov.offImage;
+                ASSERT_EQ(q.kind, PrimitiveKind::Culled);
+                ASSERT_TRUE(q.range.empty());
+                ASSERT_EQ(q.hasExactMap, exact);
+            } else {
+                ++(exact ? cov.exact : cov.splats);
+                ASSERT_EQ(q.kind, exact ? PrimitiveKind::SplatExactIndex : PrimitiveKind::Splat);
+            }
             ASSERT_EQ(q.centre, glm::vec2(float(lanes.centreX[k]), float(lanes.centreY[k])));
             ASSERT_EQ(q.conic, glm::vec3(float(lanes.conicXX[k]), float(lanes.conicXY[k]), float(lanes.conicYY[k])));
             ASSERT_EQ(q.scale, float(0.7f * lanes.amplitude[k]));
             ASSERT_EQ(q.sin2Alpha, float(lanes.sinAlpha[k] * lanes.sinAlpha[k]));
             const PixelRange r = lanes.range(k);
             ASSERT_TRUE(r.x0 == q.range.x0 && r.y0 == q.range.y0 && r.x1 == q.range.x1 && r.y1 == q.range.y1);
-            if (status == SplatLanes::kExactIndex) {
+            if (exact) {
                 const ExactIndexMap m = lanes.exactMap(k);
                 ASSERT_EQ(m.v0, q.exactMap.v0);
                 ASSERT_EQ(m.vx, q.exactMap.vx);
@@ -112,6 +125,7 @@ TEST(ProjectVector, LanesEqualTheScalarProjection) {
                     EXPECT_GT(cov.splats, 300);
                     EXPECT_EQ(cov.exact, 0);
                 }
+                EXPECT_GT(cov.offImage, 300);
                 EXPECT_GT(cov.declined, 300);
             }
 }
