@@ -22,9 +22,8 @@ ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVarianc
     if (!e.isEllipse())
         throw std::invalid_argument(std::string("makeScreenKernel: sphere is '") + sphereClassName(e.kind) +
                                     "', not an ellipse (use the halfRayFootprint fallback)");
-    const double toSupport = kernel.radius() / kernel.sigma();  // std → support semi-axis
     // V = R_u diag((a s_g/R)², (b s_g/R)²) R_uᵀ; V' = V + V_h I has the same eigenvectors.
-    const double widen = toSupport * toSupport * std::max(prefilterVariance, 0.0);
+    const double widen = supportWidening(kernel, prefilterVariance);
     ScreenKernel k;
     k.centre = e.centre;
     k.u = e.u;

@@ -208,8 +208,7 @@ std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx) {
     lanes.focal = ctx.camera.focal();
     lanes.principalX = ctx.camera.principal().x, lanes.principalY = ctx.camera.principal().y;
     lanes.radius = ctx.tables.kernel->radius() * ctx.voxelSize;  // makeSplat's sphere
-    const double toSupport = ctx.tables.kernel->radius() / ctx.tables.kernel->sigma();  // makeScreenKernel
-    lanes.widen = toSupport * toSupport * std::max(ctx.prefilterVariance, 0.0);
+    lanes.widen = supportWidening(*ctx.tables.kernel, ctx.prefilterVariance);
     lanes.spacingTimesFocal = ctx.voxelSize * ctx.camera.focal();
     lanes.threshold = ctx.threshold;
     lanes.pointsBelow = ctx.mode == RenderMode::Hybrid;

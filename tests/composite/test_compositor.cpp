@@ -18,20 +18,13 @@
 #include "footprint/kernel.h"
 #include "pointfilter/point_filter.h"
 #include "render/project.h"
+#include "support/projection.h"
 
 namespace vdbsplat {
 namespace {
 
-const Tables& tables() {
-    static const Tables t = buildTables();
-    return t;
-}
-
-Camera testCamera(int size) {
-    CameraSpec spec;
-    spec.width = spec.height = size;
-    return makeCamera(spec, glm::dvec3(-8.0), glm::dvec3(8.0));
-}
+const Tables& tables() { return test::sharedTables(); }
+Camera testCamera(int size) { return test::boxCamera(size); }
 
 struct TileArrays {
     alignas(64) std::array<float, 256> T, R, G, B;

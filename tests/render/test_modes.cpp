@@ -18,6 +18,7 @@
 #include "render/project.h"
 #include "render/project_modes.h"
 #include "render/render.h"
+#include "support/projection.h"
 #include "volume/generate.h"
 
 namespace vdbsplat {
@@ -25,10 +26,7 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-const Tables& tables() {
-    static const Tables t = buildTables();
-    return t;
-}
+const Tables& tables() { return test::sharedTables(); }
 
 /// 80° field of view: voxels up to 40° off the axis stay on screen.
 Camera testCamera(int size = 512, double fov = 80.0) {

@@ -13,21 +13,14 @@
 #include "footprint/kernel.h"
 #include "footprint/tables.h"
 #include "render/project.h"
+#include "support/projection.h"
 #include "render/project_vector.h"
 
 namespace vdbsplat {
 namespace {
 
-const Tables& tables() {
-    static const Tables t = buildTables();
-    return t;
-}
-
-Camera testCamera(int size) {
-    CameraSpec spec;
-    spec.width = spec.height = size;
-    return makeCamera(spec, glm::dvec3(-8.0), glm::dvec3(8.0));
-}
+const Tables& tables() { return test::sharedTables(); }
+Camera testCamera(int size) { return test::boxCamera(size); }
 
 /// Voxel centres of every kind the projection meets (h = 0.1, kernel radius 0.2; f ≈ 119 px at 64 px).
 std::vector<glm::vec3> testVoxels() {
@@ -180,7 +173,9 @@ TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
         ASSERT_EQ(p.shape, q.shape) << i;
         ASSERT_EQ(p.scale, q.scale) << i;
         ASSERT_EQ(p.color, q.color) << i;
-        if (p.hasExactMap) ASSERT_EQ(lanes.extra[i].exactMap.A, scalar.extra[i].exactMap.A) << i;
+        if (p.hasExactMap) {
+            ASSERT_EQ(lanes.extra[i].exactMap.A, scalar.extra[i].exactMap.A) << i;
+        }
     }
 }
 
