@@ -1,8 +1,8 @@
 // composite/compositor.h — the one EWA-filtered, front-to-back compositor (DESIGN §4, §5).
 // Owns: the frame (premultiplied colour and transmittance per pixel), ordering a
 // window's primitives by a (slab, kind, depth, index) key (a stable radix sort of
-// packed keys) and gathering them as 64-byte tile records, binning those to 16×16
-// screen tiles, and compositing every tile's list independently and in parallel:
+// packed keys) and gathering them as 64-byte tile records, binning those to square
+// screen tiles (composite/tile.h), and compositing every tile's list independently and in parallel:
 //   - points of one slab are summed into a slab buffer (optical depth and
 //     σ-weighted colour) and composited when the slab ends, so side-by-side
 //     points never occlude each other;
@@ -25,6 +25,7 @@
 
 #include "composite/compositing.h"
 #include "composite/primitive.h"
+#include "composite/tile.h"
 #include "footprint/ellipse.h"
 #include "footprint/ellipsoid.h"
 #include "footprint/prefilter.h"
@@ -35,7 +36,6 @@
 
 namespace vdbsplat {
 
-inline constexpr int kTileSize = 16;
 /// Transmittance below which a pixel is finished (early termination).
 inline constexpr float kTransmittanceEpsilon = 1e-4f;
 

@@ -18,7 +18,7 @@ namespace vdbsplat {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-constexpr int kStride = 16;  // tile row stride (kTileSize)
+constexpr int kStride = kTileSize;  // tile row stride
 
 
 /// kSlabs false: the kernel order, into one slab's sums (@p tile); true: into @p slabs by their
@@ -131,7 +131,7 @@ void drawPointSlabsVector(const PointRaster& p, const SlabTargets& slabs, const 
 void drawPointVector(const PointRaster& p, const SlabTile& tile) { HWY_DYNAMIC_DISPATCH(DrawPoint)(p, tile); }
 
 void drawPointSlabsScalar(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0) {
-    constexpr int kStride = 16;
+    constexpr int kStride = kTileSize;
     const PointFilterTable& table = *p.table;
     for (int y = p.y0; y <= p.y1; ++y) {
         const float dy = PointSetup::offset(y, p.cy), dy2 = dy * dy;

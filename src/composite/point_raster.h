@@ -15,12 +15,13 @@
 #include <glm/glm.hpp>
 
 #include "composite/slab_profile.h"
+#include "composite/tile.h"
 #include "pointfilter/point_filter.h"
 
 namespace vdbsplat {
 
 /// @brief One tile's slab buffer (optical depth and σ-weighted emission per channel) and its
-/// transmittance: row-major, stride 16 (kTileSize), 64-byte aligned arrays.
+/// transmittance: row-major, stride kTileSize (composite/tile.h), 64-byte aligned arrays.
 struct SlabTile {
     float* tau;
     float* er;

@@ -35,7 +35,7 @@ struct SlabProfile {
 
 /// @brief The slab sums of one tile a primitive deposits into (--compositing slabs), each with the
 /// fraction of the primitive's optical depth it takes: per pixel, slab j's τ += fraction[j]·τ and its
-/// emission += fraction[j]·τ·colour. Arrays as the tile's (row-major, stride 16, 64-byte aligned).
+/// emission += fraction[j]·τ·colour. Arrays as the tile's (row-major, stride kTileSize, 64-byte aligned).
 struct SlabTargets {
     int count = 0;
     std::array<float*, kMaxSlabSpan> tau{}, er{}, eg{}, eb{};

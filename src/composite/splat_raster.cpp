@@ -19,7 +19,8 @@ namespace vdbsplat {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-constexpr int kStride = 16;  // tile row stride (kTileSize)
+constexpr int kStride = kTileSize;  // tile row stride
+constexpr int kPairLanes = 16;  // DrawRowPairs: two rows of 8 pixels per vector (16-lane targets)
 
 /// The row's chord of the support ellipse i² < 1 (one pixel of slack each side; the mask decides).
 inline bool rowChord(const SplatRaster& s, float dy, int& xa, int& xb) {
@@ -61,12 +62,31 @@ HWY_INLINE V Tau(D d, const SplatRaster& s, V dx, V dy, V i2, M& mask) {
     return hn::Max(hn::Mul(hn::Mul(hn::Set(d, s.scale), hn::Sqrt(hn::Sub(one, t))), p), zero);
 }
 
+/// α = 1 − e^{−τ} for τ ≥ 0. A vector whose lanes all have τ < 1/2 takes the Taylor series to τ⁸
+/// (Horner, 7 FMAs: truncation below τ⁹/9! < 5.4e−9, under a float ulp of α ≥ τ/2·… for every
+/// τ < 1/2, and no cancellation for small τ); any other vector Highway's Expm1 (≈ 30 operations,
+/// a fifth of the splat loop when it served every vector). Semi-transparent volumes are almost
+/// all series; opaque voxels' first deposits take Expm1.
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V OpacityFromTau(D d, V tau) {
+    if (hn::AllTrue(d, hn::Lt(tau, hn::Set(d, 0.5f)))) {
+        V p = hn::Set(d, -1.f / 40320.f);
+        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 5040.f));
+        p = hn::MulAdd(p, tau, hn::Set(d, -1.f / 720.f));
+        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 120.f));
+        p = hn::MulAdd(p, tau, hn::Set(d, -1.f / 24.f));
+        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 6.f));
+        p = hn::MulAdd(p, tau, hn::Set(d, -0.5f));
+        p = hn::MulAdd(p, tau, hn::Set(d, 1.f));
+        return hn::Mul(p, tau);
+    }
+    return hn::Neg(hn::Expm1(d, hn::Neg(tau)));  // 1 − e^{−τ}
+}
+
 /// T·α of the splat (Tau), α = 1 − e^{−τ}.
 template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
 HWY_INLINE V OpacityTimesT(D d, const SplatRaster& s, V dx, V dy, V i2, V T, M& mask) {
-    const V tau = Tau(d, s, dx, dy, i2, mask);
-    const V alpha = hn::Neg(hn::Expm1(d, hn::Neg(tau)));  // 1 − e^{−τ}
-    return hn::Mul(T, alpha);
+    return hn::Mul(T, OpacityFromTau(d, Tau(d, s, dx, dy, i2, mask)));
 }
 
 /// --compositing slabs: τ·fraction_j and τ·fraction_j·c added to slab j's sums at the lanes of
@@ -135,35 +155,45 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
 }
 
 #if HWY_TARGET != HWY_SCALAR
+/// What DrawRowPairs needs of each row with a chord, set up once per splat and tile: the row's
+/// offset in the tile, the image x of its 8-pixel window, its dy, and which of the window's 8
+/// pixels lie on the chord [xa, xb] (bit j: pixel start + j).
+struct RowWindows {
+    static constexpr int kMax = kPairLanes;
+    alignas(64) float xBase[kMax];  ///< float(image x of the window's first pixel)
+    alignas(64) float dy[kMax];     ///< pixel centre y − cy
+    int offset[kMax];               ///< (y − tile.y0)·stride + window start
+    uint8_t bits[kMax];             ///< the chord's pixels in the window
+    int count = 0;
+};
+
 /// A small splat on a 16-lane target: every row's chord fits in 8 pixels, so two rows share one
 /// vector (the lower half one row's 8 pixels from its chord's start, the upper half the next
 /// row's): half the vectors of DrawRowsWide, whose one vector per row leaves most lanes idle
-/// for a splat a few pixels wide. Same per-pixel operations, so the same values.
+/// for a splat a few pixels wide. Same per-pixel operations, so the same values. The rows' dy,
+/// window positions and chord masks come prepared (RowWindows), so a pair costs two broadcasts
+/// and a mask load before the footprint.
 template <bool kSlabs, class D>
-void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const int* rows, const int* starts,
-                  const int* xas, const int* xbs, int count) {
+void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowWindows& w) {
     using V = hn::Vec<D>;
     const hn::Half<D> dh;
-    using VH = hn::Vec<decltype(dh)>;
-    const VH laneH = hn::Iota(dh, 0.5f);
-    const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon);
+    const V lanes = hn::Combine(d, hn::Iota(dh, 0.5f), hn::Iota(dh, 0.5f));  // pixel centre offsets, per half
+    const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon), cx = hn::Set(d, s.cx);
     const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
-    constexpr int kHalf = kStride / 2;
+    const int count = w.count;
     for (int k = 0; k < count; k += 2) {
         const bool pair = k + 1 < count;
         const int ka = k, kb = pair ? k + 1 : k;  // a lone last row: its upper half repeats it, masked off
-        const auto both = [&](float a, float b) { return hn::Combine(d, hn::Set(dh, b), hn::Set(dh, a)); };
-        const V xPix = hn::Combine(d, hn::Add(hn::Set(dh, float(tile.x0 + starts[kb])), laneH),
-                                   hn::Add(hn::Set(dh, float(tile.x0 + starts[ka])), laneH));
-        const V dx = hn::Sub(xPix, hn::Set(d, s.cx));
-        const V dy = both(float(rows[ka]) + 0.5f - s.cy, float(rows[kb]) + 0.5f - s.cy);
-        const V lo = both(float(xas[ka]), float(xas[kb])), hi = both(float(xbs[ka]) + 0.75f, float(xbs[kb]) + 0.75f);
+        const auto both = [&](const float* a) { return hn::Combine(d, hn::Set(dh, a[kb]), hn::Set(dh, a[ka])); };
+        const V xPix = hn::Add(both(w.xBase), lanes);  // pixel centres
+        const V dx = hn::Sub(xPix, cx);
+        const V dy = both(w.dy);
         const V i2 = IndexSquared(d, s, dx, dy);
-        const int offA = (rows[ka] - tile.y0) * kStride + starts[ka], offB = (rows[kb] - tile.y0) * kStride + starts[kb];
+        const int offA = w.offset[ka], offB = w.offset[kb];
         const auto load = [&](const float* base) { return hn::Combine(d, hn::LoadU(dh, base + offB), hn::LoadU(dh, base + offA)); };
         const V T = load(tile.T);
-        auto mask = hn::And(hn::And(hn::Ge(xPix, lo), hn::Lt(xPix, hi)), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
-        if (!pair) mask = hn::And(mask, hn::FirstN(d, kHalf));
+        const uint8_t chord[8] = {w.bits[ka], uint8_t(pair ? w.bits[kb] : 0)};
+        auto mask = hn::And(hn::LoadMaskBits(d, chord), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
         if (hn::AllFalse(d, mask)) continue;
         const auto store = [&](float* base, V value) {
             hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
@@ -182,6 +212,50 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const int*
     }
 }
 
+/// Every row's chord at once (rowChord's arithmetic, one lane per row of the splat's rows in the
+/// tile), then the rows with a chord, and whether an 8-pixel window from each chord's start holds
+/// it; if every row's does, draws them two by two (DrawRowPairs) and returns true.
+template <bool kSlabs, class D>
+bool DrawRowPairsIfNarrow(D d, const SplatRaster& s, const TileBuffers& tile) {
+    constexpr int kHalf = kPairLanes / 2;
+    const hn::RebindToSigned<D> di;
+    RowWindows w;
+    const auto dy = hn::Sub(hn::Iota(d, float(s.y0) + 0.5f), hn::Set(d, s.cy));  // float(y) + 0.5 − cy
+    hn::Store(dy, d, w.dy);
+    const auto b = hn::Mul(hn::Set(d, s.qxy), dy);
+    const auto disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, s.qxx), hn::Sub(hn::Mul(hn::Mul(hn::Set(d, s.qyy), dy), dy), hn::Set(d, 1.f))));
+    const auto has = hn::And(hn::Gt(disc, hn::Zero(d)), hn::FirstN(d, size_t(s.y1 - s.y0 + 1)));
+    const auto root = hn::Sqrt(hn::Max(disc, hn::Zero(d)));
+    // One reciprocal instead of two vector divisions: the chord keeps a pixel of slack each
+    // side (floor, ceil) and the mask's i² < 1 decides every pixel, so a last-bit difference
+    // in lo or hi draws the same pixels with the same values.
+    const auto base = hn::Set(d, s.cx - 0.5f), invQxx = hn::Set(d, 1.f / s.qxx);
+    const auto lo = hn::MulAdd(hn::Sub(hn::Neg(b), root), invQxx, base);
+    const auto hi = hn::MulAdd(hn::Sub(root, b), invQxx, base);
+    alignas(64) int32_t xaAll[kPairLanes], xbAll[kPairLanes];
+    hn::Store(hn::ConvertTo(di, hn::Max(hn::Floor(lo), hn::Set(d, float(s.x0)))), di, xaAll);
+    hn::Store(hn::ConvertTo(di, hn::Min(hn::Ceil(hi), hn::Set(d, float(s.x1)))), di, xbAll);
+    uint8_t hasBits[8] = {};
+    hn::StoreMaskBits(d, has, hasBits);
+    const unsigned rowsWithChord = unsigned(hasBits[0]) | unsigned(hasBits[1]) << 8;
+    bool narrow = true;
+    for (unsigned m = rowsWithChord; m != 0 && narrow; m &= m - 1) {
+        const int k = std::countr_zero(m), xa = xaAll[k], xb = xbAll[k];
+        if (xa > xb) continue;
+        if (xb - xa >= kHalf) narrow = false;
+        const int start = std::min(xa - tile.x0, kStride - kHalf);  // [start, start + 8) ⊇ [xa, xb] − x0, inside the row
+        const int n = w.count++;
+        w.dy[n] = w.dy[k];  // n ≤ k: compacts in place
+        w.xBase[n] = float(tile.x0 + start);
+        w.offset[n] = (s.y0 + k - tile.y0) * kStride + start;
+        // Pixel x is on the chord iff xa ≤ x ≤ xb (the mask xa ≤ x + ½ < xb + ¾ of DrawRowsWide).
+        w.bits[n] = uint8_t(((1u << (xb - xa + 1)) - 1u) << (xa - tile.x0 - start));
+    }
+    if (!narrow) return false;
+    if (w.count > 0) DrawRowPairs<kSlabs>(d, s, tile, w);
+    return true;
+}
+
 #endif  // HWY_TARGET != HWY_SCALAR
 
 // The order is a template argument, so the kernel order's loops are the code they were before the
@@ -189,39 +263,9 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const int*
 template <bool kSlabs, class D>
 void DrawSplatRowsFor(D d, const SplatRaster& s, const TileBuffers& tile) {
 #if HWY_TARGET != HWY_SCALAR
-    if constexpr (hn::MaxLanes(D()) == kStride) {
-        // Every row's chord at once (rowChord's arithmetic, one lane per row of the tile), then
-        // the rows with a chord, and whether an 8-pixel window from each chord's start holds it.
-        constexpr int kHalf = kStride / 2;
-        const hn::RebindToSigned<D> di;
-        const auto dy = hn::Sub(hn::Iota(d, float(s.y0) + 0.5f), hn::Set(d, s.cy));
-        const auto b = hn::Mul(hn::Set(d, s.qxy), dy);
-        const auto disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, s.qxx), hn::Sub(hn::Mul(hn::Mul(hn::Set(d, s.qyy), dy), dy), hn::Set(d, 1.f))));
-        const auto has = hn::And(hn::Gt(disc, hn::Zero(d)), hn::FirstN(d, size_t(s.y1 - s.y0 + 1)));
-        const auto root = hn::Sqrt(hn::Max(disc, hn::Zero(d)));
-        const auto base = hn::Set(d, s.cx - 0.5f), qxx = hn::Set(d, s.qxx);
-        const auto lo = hn::Add(base, hn::Div(hn::Sub(hn::Neg(b), root), qxx));
-        const auto hi = hn::Add(base, hn::Div(hn::Sub(root, b), qxx));
-        alignas(64) int32_t xaAll[kStride], xbAll[kStride];
-        hn::Store(hn::ConvertTo(di, hn::Max(hn::Floor(lo), hn::Set(d, float(s.x0)))), di, xaAll);
-        hn::Store(hn::ConvertTo(di, hn::Min(hn::Ceil(hi), hn::Set(d, float(s.x1)))), di, xbAll);
-        uint8_t hasBits[8] = {};
-        hn::StoreMaskBits(d, has, hasBits);
-        const unsigned rowsWithChord = unsigned(hasBits[0]) | unsigned(hasBits[1]) << 8;
-        int rows[kStride], starts[kStride], xas[kStride], xbs[kStride], count = 0;
-        bool narrow = true;
-        for (unsigned m = rowsWithChord; m != 0 && narrow; m &= m - 1) {
-            const int k = std::countr_zero(m), xa = xaAll[k], xb = xbAll[k];
-            if (xa > xb) continue;
-            if (xb - xa >= kHalf) narrow = false;
-            rows[count] = s.y0 + k, xas[count] = xa, xbs[count] = xb;
-            starts[count] = std::min(xa - tile.x0, kHalf);  // [start, start + 8) ⊇ [xa, xb] − x0, inside the row
-            ++count;
-        }
-        if (narrow) {
-            if (count > 0) DrawRowPairs<kSlabs>(d, s, tile, rows, starts, xas, xbs, count);
-            return;
-        }
+    // Splats up to 16 rows tall in the tile whose every chord fits 8 pixels: two rows a vector.
+    if constexpr (hn::MaxLanes(D()) == kPairLanes) {
+        if (s.y1 - s.y0 + 1 <= kPairLanes && DrawRowPairsIfNarrow<kSlabs>(d, s, tile)) return;
     }
 #else
     (void)d;
@@ -230,8 +274,8 @@ void DrawSplatRowsFor(D d, const SplatRaster& s, const TileBuffers& tile) {
 }
 
 void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) {
-    if (s.slabs) return DrawSplatRowsFor<true>(hn::CappedTag<float, kStride>(), s, tile);
-    DrawSplatRowsFor<false>(hn::CappedTag<float, kStride>(), s, tile);
+    if (s.slabs) return DrawSplatRowsFor<true>(hn::CappedTag<float, kPairLanes>(), s, tile);
+    DrawSplatRowsFor<false>(hn::CappedTag<float, kPairLanes>(), s, tile);
 }
 
 /// One slab over the tile's live pixels, then emptied (compositeSlabVector).
@@ -273,7 +317,7 @@ void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const Tile
 void drawSplatVector(const SplatRaster& s, const TileBuffers& tile) { HWY_DYNAMIC_DISPATCH(DrawSplatRows)(s, tile); }
 
 void drawSplatScalarPoly(const SplatRaster& s, const TileBuffers& tile) {
-    constexpr int kStride = 16;
+    constexpr int kStride = kTileSize;
     for (int y = s.y0; y <= s.y1; ++y) {
         const float dy = float(y) + 0.5f - s.cy;
         for (int x = s.x0; x <= s.x1; ++x) {

@@ -17,12 +17,13 @@
 #include <glm/glm.hpp>
 
 #include "composite/slab_profile.h"
+#include "composite/tile.h"
 #include "footprint/footprint_poly.h"
 #include "footprint/screen_kernel.h"
 
 namespace vdbsplat {
 
-/// @brief One tile's pixels: row-major, stride 16 (kTileSize), 64-byte aligned arrays.
+/// @brief One tile's pixels: row-major, stride kTileSize (composite/tile.h), 64-byte aligned arrays.
 struct TileBuffers {
     float* T;          ///< transmittance
     float* R;          ///< premultiplied radiance, per channel
@@ -50,7 +51,7 @@ struct SplatRaster {
 void drawSplatVector(const SplatRaster& s, const TileBuffers& tile);
 
 /// @brief --compositing slabs: composites one slab of a tile (optical depth @p tau and σ-weighted
-/// emission @p er, @p eg, @p eb, 256 pixels each) onto @p tile's live pixels (T ≥ @p epsilon):
+/// emission @p er, @p eg, @p eb, kTilePixels each) onto @p tile's live pixels (T ≥ @p epsilon):
 /// α = 1 − e^{−τ}, C += T·α·e/τ, T *= 1 − α; then empties the slab. Vectorised (Highway).
 void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon);
 

@@ -27,7 +27,7 @@ const Tables& tables() { return test::sharedTables(); }
 Camera testCamera(int size) { return test::boxCamera(size); }
 
 struct TileArrays {
-    alignas(64) std::array<float, 256> T, R, G, B;
+    alignas(64) std::array<float, kTilePixels> T, R, G, B;
     TileBuffers buffers(int x0, int y0) { return {T.data(), R.data(), G.data(), B.data(), x0, y0}; }
 };
 
@@ -57,13 +57,15 @@ TEST(SplatRaster, VectorLoopMatchesTheScalarLoop) {
         s.color = glm::vec3(u(rng), u(rng), u(rng));
         s.epsilon = kTransmittanceEpsilon;
         // The tile under the ellipse centre, clipped.
-        const int tx0 = std::clamp(int(std::floor(s.cx / 16.f)), 0, 3) * 16, ty0 = std::clamp(int(std::floor(s.cy / 16.f)), 0, 3) * 16;
+        constexpr int kLastTile = 64 / kTileSize - 1;
+        const int tx0 = std::clamp(int(std::floor(s.cx / kTileSize)), 0, kLastTile) * kTileSize;
+        const int ty0 = std::clamp(int(std::floor(s.cy / kTileSize)), 0, kLastTile) * kTileSize;
         const PixelRange r = pixelRange(k.bounds, 64, 64);
-        s.x0 = std::max(r.x0, tx0), s.x1 = std::min(r.x1, tx0 + 15);
-        s.y0 = std::max(r.y0, ty0), s.y1 = std::min(r.y1, ty0 + 15);
+        s.x0 = std::max(r.x0, tx0), s.x1 = std::min(r.x1, tx0 + kTileSize - 1);
+        s.y0 = std::max(r.y0, ty0), s.y1 = std::min(r.y1, ty0 + kTileSize - 1);
         if (s.x0 > s.x1 || s.y0 > s.y1) continue;
         TileArrays a, b;
-        for (size_t i = 0; i < 256; ++i) {
+        for (size_t i = 0; i < size_t(kTilePixels); ++i) {
             a.T[i] = u(rng) < 0.1f ? 0.5f * kTransmittanceEpsilon : u(rng);
             a.R[i] = u(rng), a.G[i] = u(rng), a.B[i] = u(rng);
         }
@@ -71,12 +73,12 @@ TEST(SplatRaster, VectorLoopMatchesTheScalarLoop) {
         const TileArrays before = a;
         drawSplatVector(s, a.buffers(tx0, ty0));
         drawSplatScalarPoly(s, b.buffers(tx0, ty0));
-        for (size_t i = 0; i < 256; ++i) {
+        for (size_t i = 0; i < size_t(kTilePixels); ++i) {
             if (b.T[i] != a.T[i] || b.R[i] != a.R[i]) ++drawn;
             worst = std::max({worst, double(std::abs(a.T[i] - b.T[i])), double(std::abs(a.R[i] - b.R[i])),
                               double(std::abs(a.G[i] - b.G[i])), double(std::abs(a.B[i] - b.B[i]))});
             // Finished pixels and pixels outside the range stay exactly as they were.
-            const int x = tx0 + int(i % 16), y = ty0 + int(i / 16);
+            const int x = tx0 + int(i % kTileSize), y = ty0 + int(i / kTileSize);
             const bool outside = x < s.x0 || x > s.x1 || y < s.y0 || y > s.y1;
             if (outside || before.T[i] < kTransmittanceEpsilon) {
                 ASSERT_EQ(a.T[i], before.T[i]) << "trial " << trial << " pixel " << i;

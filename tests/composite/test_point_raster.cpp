@@ -13,7 +13,7 @@ namespace vdbsplat {
 namespace {
 
 struct SlabArrays {
-    alignas(64) std::array<float, 256> tau, er, eg, eb, T;
+    alignas(64) std::array<float, kTilePixels> tau, er, eg, eb, T;
     SlabTile tile(int x0, int y0) { return {tau.data(), er.data(), eg.data(), eb.data(), T.data(), x0, y0}; }
 };
 
@@ -24,15 +24,15 @@ TEST(PointRaster, VectorLoopEqualsTheScalarLoop) {
     constexpr float kEpsilon = 1e-4f;
     int drawn = 0, skippedFinished = 0;
     for (int trial = 0; trial < 4000; ++trial) {
-        const int tx0 = 16 * int(4 * u(rng)), ty0 = 16 * int(4 * u(rng));  // the tile's first pixel
+        const int tx0 = kTileSize * int(4 * u(rng)), ty0 = kTileSize * int(4 * u(rng));  // the tile's first pixel
         SlabArrays a, b;
-        for (size_t i = 0; i < 256; ++i) {
+        for (size_t i = 0; i < size_t(kTilePixels); ++i) {
             a.tau[i] = u(rng) < 0.3f ? 0.f : u(rng), a.er[i] = u(rng), a.eg[i] = u(rng), a.eb[i] = u(rng);
             a.T[i] = u(rng) < 0.2f ? kEpsilon * u(rng) : u(rng);  // some pixels finished
         }
         b = a;
         // A centre in or near the tile; variances of both low-passes and of --mode none.
-        const float cx = float(tx0) - 4.f + 24.f * u(rng), cy = float(ty0) - 4.f + 24.f * u(rng);
+        const float cx = float(tx0) - 4.f + float(kTileSize + 8) * u(rng), cy = float(ty0) - 4.f + float(kTileSize + 8) * u(rng);
         const float v = trial % 7 == 0 ? 1.f / 36.f : float(pointFilterVariance(2.5 * u(rng), trial % 2 ? 0.1 : 1.0));
         const PointSetup s = setupPoint(table, PixelCoord(cx, cy), v);
         if (s.empty()) continue;
@@ -40,14 +40,14 @@ TEST(PointRaster, VectorLoopEqualsTheScalarLoop) {
         p.cx = cx, p.cy = cy, p.invVariance = s.invVariance, p.radius2 = s.radius2, p.norm = s.norm;
         p.total = 0.01f + 5.f * u(rng);
         p.color = glm::vec3(u(rng), u(rng), u(rng));
-        p.x0 = std::max(s.x0, tx0), p.x1 = std::min(s.x0 + s.nx - 1, tx0 + 15);
-        p.y0 = std::max(s.y0, ty0), p.y1 = std::min(s.y0 + s.ny - 1, ty0 + 15);
+        p.x0 = std::max(s.x0, tx0), p.x1 = std::min(s.x0 + s.nx - 1, tx0 + kTileSize - 1);
+        p.y0 = std::max(s.y0, ty0), p.y1 = std::min(s.y0 + s.ny - 1, ty0 + kTileSize - 1);
         p.epsilon = kEpsilon;
         p.table = &table;
         const SlabArrays before = a;
         drawPointScalar(p, a.tile(tx0, ty0));
         drawPointVector(p, b.tile(tx0, ty0));
-        for (size_t i = 0; i < 256; ++i) {
+        for (size_t i = 0; i < size_t(kTilePixels); ++i) {
             ASSERT_EQ(a.tau[i], b.tau[i]) << "trial " << trial << " pixel " << i;
             ASSERT_EQ(a.er[i], b.er[i]) << trial;
             ASSERT_EQ(a.eg[i], b.eg[i]) << trial;
@@ -55,9 +55,9 @@ TEST(PointRaster, VectorLoopEqualsTheScalarLoop) {
         }
         // The scalar loop deposits total · w with rasterizePoint's w, on live pixels only.
         const PointFootprint fp = rasterizePoint(table, PixelCoord(cx, cy), v);
-        for (int y = ty0; y < ty0 + 16; ++y)
-            for (int x = tx0; x < tx0 + 16; ++x) {
-                const size_t i = size_t(y - ty0) * 16 + size_t(x - tx0);
+        for (int y = ty0; y < ty0 + kTileSize; ++y)
+            for (int x = tx0; x < tx0 + kTileSize; ++x) {
+                const size_t i = size_t(y - ty0) * kTileSize + size_t(x - tx0);
                 const bool inside = x >= fp.x0 && x < fp.x0 + fp.nx && y >= fp.y0 && y < fp.y0 + fp.ny;
                 const bool live = before.T[i] >= kEpsilon;
                 const float tau = inside && live ? p.total * fp.at(x - fp.x0, y - fp.y0) : 0.f;
