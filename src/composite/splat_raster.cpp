@@ -114,7 +114,10 @@ HWY_INLINE V IndexSquared(D d, const SplatRaster& s, V dx, V dy) {
                       hn::Mul(hn::MulAdd(hn::Set(d, 2.f * s.qxy), dx, hn::Mul(hn::Set(d, s.qyy), dy)), dy));
 }
 
-/// One row, one vector per n pixels of its chord.
+/// One row, one vector per n pixels of its chord, the first starting at the chord's first pixel
+/// (a chord of up to n pixels is one vector wherever it lies; aligned starts took two for most
+/// chords of a close-up's splats). A vector that would run past the row's end is moved back
+/// inside it, and its lanes the previous vector drew are masked off.
 template <bool kSlabs>
 void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
     const hn::CappedTag<float, kStride> d;
@@ -128,28 +131,30 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
         int xa, xb;
         if (!rowChord(s, dyf, xa, xb)) continue;
         const V dy = hn::Set(d, dyf);
-        const V lo = hn::Set(d, float(xa)), hi = hn::Set(d, float(xb) + 0.75f);
+        const V hi = hn::Set(d, float(xb) + 0.75f);
         const int row = (y - tile.y0) * kStride;
-        for (int c = (xa - tile.x0) / n * n; c <= xb - tile.x0; c += n) {
+        for (int from = xa - tile.x0; from <= xb - tile.x0; from += n) {
+            const int c = std::min(from, kStride - n);  // the vector's first pixel, inside the row
+            const V lo = hn::Set(d, float(tile.x0 + from));  // pixels from `from` on: not drawn yet
             const V xPix = hn::Add(hn::Set(d, float(tile.x0 + c)), lane);  // pixel centres
             const V dx = hn::Sub(xPix, hn::Set(d, s.cx));
             const V i2 = IndexSquared(d, s, dx, dy);
             float* pt = tile.T + row + c;
-            const V T = hn::Load(d, pt);
+            const V T = hn::LoadU(d, pt);
             auto mask = hn::And(hn::And(hn::Ge(xPix, lo), hn::Lt(xPix, hi)), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
             if (hn::AllFalse(d, mask)) continue;
             if constexpr (kSlabs) {
                 const V tau = Tau(d, s, dx, dy, i2, mask);
-                DepositSlabs(d, s, tau, mask, [&](float* base) { return hn::Load(d, base + row + c); },
-                             [&](float* base, V v) { hn::Store(v, d, base + row + c); });
+                DepositSlabs(d, s, tau, mask, [&](float* base) { return hn::LoadU(d, base + row + c); },
+                             [&](float* base, V v) { hn::StoreU(v, d, base + row + c); });
                 continue;
             }
             const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
             float *pr = tile.R + row + c, *pg = tile.G + row + c, *pb = tile.B + row + c;
-            hn::Store(hn::IfThenElse(mask, hn::MulAdd(ta, cr, hn::Load(d, pr)), hn::Load(d, pr)), d, pr);
-            hn::Store(hn::IfThenElse(mask, hn::MulAdd(ta, cg, hn::Load(d, pg)), hn::Load(d, pg)), d, pg);
-            hn::Store(hn::IfThenElse(mask, hn::MulAdd(ta, cb, hn::Load(d, pb)), hn::Load(d, pb)), d, pb);
-            hn::Store(hn::IfThenElse(mask, hn::Sub(T, ta), T), d, pt);  // T·(1 − α)
+            hn::StoreU(hn::IfThenElse(mask, hn::MulAdd(ta, cr, hn::LoadU(d, pr)), hn::LoadU(d, pr)), d, pr);
+            hn::StoreU(hn::IfThenElse(mask, hn::MulAdd(ta, cg, hn::LoadU(d, pg)), hn::LoadU(d, pg)), d, pg);
+            hn::StoreU(hn::IfThenElse(mask, hn::MulAdd(ta, cb, hn::LoadU(d, pb)), hn::LoadU(d, pb)), d, pb);
+            hn::StoreU(hn::IfThenElse(mask, hn::Sub(T, ta), T), d, pt);  // T·(1 − α)
         }
     }
 }
