@@ -160,16 +160,17 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
 }
 
 #if HWY_TARGET != HWY_SCALAR
-/// What DrawRowPairs needs of each row with a chord, set up once per splat and tile: the row's
-/// offset in the tile, the image x of its 8-pixel window, its dy, and which of the window's 8
-/// pixels lie on the chord [xa, xb] (bit j: pixel start + j).
+/// What DrawRowPairs needs of the rows y0 … y0 + 15 of a splat in a tile (lane k: row y0 + k),
+/// set up once per splat and tile: the rows with a chord are [first, first + count); each one's
+/// dy, offset in the tile, the image x of its 8-pixel window, and which of the window's 8 pixels
+/// lie on its chord [xa, xb] (bit j: pixel start + j).
 struct RowWindows {
     static constexpr int kMax = kPairLanes;
-    alignas(64) float xBase[kMax];  ///< float(image x of the window's first pixel)
-    alignas(64) float dy[kMax];     ///< pixel centre y − cy
-    int offset[kMax];               ///< (y − tile.y0)·stride + window start
-    uint8_t bits[kMax];             ///< the chord's pixels in the window
-    int count = 0;
+    alignas(64) float dy[kMax];       ///< pixel centre y − cy
+    alignas(64) float xBase[kMax];    ///< float(image x of the window's first pixel)
+    alignas(64) int32_t offset[kMax]; ///< (y − tile.y0)·stride + window start
+    alignas(64) int32_t bits[kMax];   ///< the chord's pixels in the window
+    int first = 0, count = 0;
 };
 
 /// A small splat on a 16-lane target: every row's chord fits in 8 pixels, so two rows share one
@@ -185,9 +186,9 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
     const V lanes = hn::Combine(d, hn::Iota(dh, 0.5f), hn::Iota(dh, 0.5f));  // pixel centre offsets, per half
     const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon), cx = hn::Set(d, s.cx);
     const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
-    const int count = w.count;
-    for (int k = 0; k < count; k += 2) {
-        const bool pair = k + 1 < count;
+    const int end = w.first + w.count;
+    for (int k = w.first; k < end; k += 2) {
+        const bool pair = k + 1 < end;
         const int ka = k, kb = pair ? k + 1 : k;  // a lone last row: its upper half repeats it, masked off
         const auto both = [&](const float* a) { return hn::Combine(d, hn::Set(dh, a[kb]), hn::Set(dh, a[ka])); };
         const V xPix = hn::Add(both(w.xBase), lanes);  // pixel centres
@@ -197,7 +198,7 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
         const int offA = w.offset[ka], offB = w.offset[kb];
         const auto load = [&](const float* base) { return hn::Combine(d, hn::LoadU(dh, base + offB), hn::LoadU(dh, base + offA)); };
         const V T = load(tile.T);
-        const uint8_t chord[8] = {w.bits[ka], uint8_t(pair ? w.bits[kb] : 0)};
+        const uint8_t chord[8] = {uint8_t(w.bits[ka]), uint8_t(pair ? w.bits[kb] : 0)};
         auto mask = hn::And(hn::LoadMaskBits(d, chord), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
         if (hn::AllFalse(d, mask)) continue;
         const auto store = [&](float* base, V value) {
@@ -218,12 +219,14 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
 }
 
 /// Every row's chord at once (rowChord's arithmetic, one lane per row of the splat's rows in the
-/// tile), then the rows with a chord, and whether an 8-pixel window from each chord's start holds
-/// it; if every row's does, draws them two by two (DrawRowPairs) and returns true.
+/// tile), and from them, in the same lanes, each row's 8-pixel window and chord mask; if the rows
+/// with a chord are one run (they are: an ellipse is convex) and every chord fits its window,
+/// draws them two by two (DrawRowPairs) and returns true.
 template <bool kSlabs, class D>
 bool DrawRowPairsIfNarrow(D d, const SplatRaster& s, const TileBuffers& tile) {
     constexpr int kHalf = kPairLanes / 2;
     const hn::RebindToSigned<D> di;
+    using VI = hn::Vec<decltype(di)>;
     RowWindows w;
     const auto dy = hn::Sub(hn::Iota(d, float(s.y0) + 0.5f), hn::Set(d, s.cy));  // float(y) + 0.5 − cy
     hn::Store(dy, d, w.dy);
@@ -237,27 +240,30 @@ bool DrawRowPairsIfNarrow(D d, const SplatRaster& s, const TileBuffers& tile) {
     const auto base = hn::Set(d, s.cx - 0.5f), invQxx = hn::Set(d, 1.f / s.qxx);
     const auto lo = hn::MulAdd(hn::Sub(hn::Neg(b), root), invQxx, base);
     const auto hi = hn::MulAdd(hn::Sub(root, b), invQxx, base);
-    alignas(64) int32_t xaAll[kPairLanes], xbAll[kPairLanes];
-    hn::Store(hn::ConvertTo(di, hn::Max(hn::Floor(lo), hn::Set(d, float(s.x0)))), di, xaAll);
-    hn::Store(hn::ConvertTo(di, hn::Min(hn::Ceil(hi), hn::Set(d, float(s.x1)))), di, xbAll);
-    uint8_t hasBits[8] = {};
-    hn::StoreMaskBits(d, has, hasBits);
-    const unsigned rowsWithChord = unsigned(hasBits[0]) | unsigned(hasBits[1]) << 8;
-    bool narrow = true;
-    for (unsigned m = rowsWithChord; m != 0 && narrow; m &= m - 1) {
-        const int k = std::countr_zero(m), xa = xaAll[k], xb = xbAll[k];
-        if (xa > xb) continue;
-        if (xb - xa >= kHalf) narrow = false;
-        const int start = std::min(xa - tile.x0, kStride - kHalf);  // [start, start + 8) ⊇ [xa, xb] − x0, inside the row
-        const int n = w.count++;
-        w.dy[n] = w.dy[k];  // n ≤ k: compacts in place
-        w.xBase[n] = float(tile.x0 + start);
-        w.offset[n] = (s.y0 + k - tile.y0) * kStride + start;
-        // Pixel x is on the chord iff xa ≤ x ≤ xb (the mask xa ≤ x + ½ < xb + ¾ of DrawRowsWide).
-        w.bits[n] = uint8_t(((1u << (xb - xa + 1)) - 1u) << (xa - tile.x0 - start));
-    }
-    if (!narrow) return false;
-    if (w.count > 0) DrawRowPairs<kSlabs>(d, s, tile, w);
+    const VI xa = hn::ConvertTo(di, hn::Max(hn::Floor(lo), hn::Set(d, float(s.x0))));
+    const VI xb = hn::ConvertTo(di, hn::Min(hn::Ceil(hi), hn::Set(d, float(s.x1))));
+    const auto onChord = hn::And(has, hn::RebindMask(d, hn::Lt(xa, hn::Add(xb, hn::Set(di, 1)))));
+    uint8_t chordBits[8] = {};
+    hn::StoreMaskBits(d, onChord, chordBits);
+    const unsigned rows = unsigned(chordBits[0]) | unsigned(chordBits[1]) << 8;
+    if (rows == 0) return true;  // nothing of the splat in this tile
+    w.first = std::countr_zero(rows);
+    const unsigned run = rows >> w.first;
+    if ((run & (run + 1)) != 0) return false;  // not one run (a last-bit case): the row loop
+    w.count = std::popcount(rows);
+    const VI width = hn::Sub(xb, xa);  // pixels − 1
+    if (!hn::AllFalse(di, hn::And(hn::RebindMask(di, onChord), hn::Gt(width, hn::Set(di, kHalf - 1))))) return false;
+    // [start, start + 8) ⊇ [xa, xb] − x0, inside the row; pixel x is on the chord iff
+    // xa ≤ x ≤ xb (the mask xa ≤ x + ½ < xb + ¾ of DrawRowsWide).
+    const VI rel = hn::Sub(xa, hn::Set(di, tile.x0));
+    const VI start = hn::Min(rel, hn::Set(di, kStride - kHalf));
+    const VI row = hn::Iota(di, s.y0 - tile.y0);
+    hn::Store(hn::Add(hn::Mul(row, hn::Set(di, kStride)), start), di, w.offset);
+    hn::Store(hn::ConvertTo(d, hn::Add(start, hn::Set(di, tile.x0))), d, w.xBase);
+    const VI ones = hn::Set(di, 1);
+    const VI run8 = hn::Sub(hn::Shl(ones, hn::Add(width, ones)), ones);  // width + 1 low bits (≤ 8)
+    hn::Store(hn::Shl(run8, hn::Sub(rel, start)), di, w.bits);
+    DrawRowPairs<kSlabs>(d, s, tile, w);
     return true;
 }
 
