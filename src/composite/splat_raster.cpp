@@ -301,7 +301,7 @@ void CompositeSlab(float* tau, float* er, float* eg, float* eb, const TileBuffer
         const V T = hn::Load(d, tile.T + i);
         const auto mask = hn::And(hn::Gt(t, zero), hn::Ge(T, eps));
         if (!hn::AllFalse(d, mask)) {
-            const V ta = hn::Mul(T, hn::Neg(hn::Expm1(d, hn::Neg(t))));  // T·α
+            const V ta = hn::Mul(T, OpacityFromTau(d, t));  // T·α
             const V w = hn::IfThenElseZero(mask, hn::Div(ta, hn::IfThenElse(mask, t, hn::Set(d, 1.f))));
             hn::Store(hn::MulAdd(w, hn::Load(d, er + i), hn::Load(d, tile.R + i)), d, tile.R + i);
             hn::Store(hn::MulAdd(w, hn::Load(d, eg + i), hn::Load(d, tile.G + i)), d, tile.G + i);

@@ -67,10 +67,19 @@ FootprintPolynomials FootprintPolynomials::build(const KernelShape& kernel) {
     FootprintPolynomials p;
     const double s = std::sin(kAlphaMaxDeg * std::numbers::pi / 180.0);
     p.sin2Max_ = s * s;
-    p.rowsPerSin2_ = kRows / p.sin2Max_;
     p.rows_.reserve(kRows + 1);
     for (int r = 0; r <= kRows; ++r) p.rows_.push_back(fitRow(p.sin2Max_ * r / kRows, kernel));
     return p;
+}
+
+FootprintPolynomials::Coefficients FootprintPolynomials::row(double sin2Alpha) const {
+    const double pos = std::clamp(sin2Alpha / sin2Max_, 0.0, 1.0) * kRows;
+    const int k = std::min(int(pos), kRows - 1);
+    const float w = float(pos - k);
+    const Coefficients &a = rows_[size_t(k)], &b = rows_[size_t(k) + 1];
+    Coefficients c;
+    for (int j = 0; j < kCoefficients; ++j) c[size_t(j)] = a[size_t(j)] + w * (b[size_t(j)] - a[size_t(j)]);
+    return c;
 }
 
 float FootprintPolynomials::evaluate(const Coefficients& c, float t) {

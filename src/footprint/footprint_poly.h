@@ -14,7 +14,6 @@
 // The α = 0 row is F as a function of d² itself: the exact-index path uses it.
 // Measured bound (FootprintPoly tests): |F_poly − F| ≤ kErrorBound·F(0), evaluated in float.
 #pragma once
-#include <algorithm>
 #include <array>
 #include <vector>
 
@@ -38,19 +37,7 @@ public:
     /// @brief True when a splat of half cone angle with sin²α = @p sin2Alpha is covered.
     bool covers(double sin2Alpha) const { return sin2Alpha >= 0.0 && sin2Alpha <= sin2Max_; }
     /// @brief The coefficients for sin²α = @p sin2Alpha (must be covered): rows interpolated linearly.
-    Coefficients row(double sin2Alpha) const {
-        Coefficients c;
-        rowInto(sin2Alpha, c);
-        return c;
-    }
-    /// @brief row() written into @p c (the compositor's per-splat set-up: no copy through the stack).
-    void rowInto(double sin2Alpha, Coefficients& c) const {
-        const double pos = std::clamp(sin2Alpha * rowsPerSin2_, 0.0, double(kRows));
-        const int k = std::min(int(pos), kRows - 1);
-        const float w = float(pos - k);
-        const float *a = rows_[size_t(k)].data(), *b = rows_[size_t(k) + 1].data();
-        for (int j = 0; j < kCoefficients; ++j) c[size_t(j)] = a[j] + w * (b[j] - a[j]);
-    }
+    Coefficients row(double sin2Alpha) const;
     /// @brief The α = 0 row: F as a polynomial in d² (for the exact-index path).
     const Coefficients& axisRow() const { return rows_.front(); }
 
@@ -64,7 +51,6 @@ public:
 private:
     std::vector<Coefficients> rows_;  // kRows + 1
     double sin2Max_ = 0.0;
-    double rowsPerSin2_ = 0.0;  ///< kRows / sin2Max_
 };
 
 }  // namespace vdbsplat
