@@ -53,7 +53,7 @@ struct ChunkRange {
 /// order, and the chunks are fixed by n, so the result does not depend on the thread count.
 template <class Entry>
 Entry* radixSort(Entry* a, Entry* scratch, size_t n, int bits) {
-    const size_t chunks = std::clamp<size_t>(n / 16384, 1, 64), per = (n + chunks - 1) / chunks;
+    const size_t chunks = std::clamp<size_t>(n / 4096, 1, 64), per = (n + chunks - 1) / chunks;
     std::vector<std::array<size_t, 256>> start(chunks);
     Entry *from = a, *to = scratch;
     for (int shift = 0; shift < bits; shift += 8) {
@@ -195,7 +195,7 @@ SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, doubl
 /// gathered is the 64-byte TileRecord, not the Primitive.
 void TileCompositor::sortWindow(const ProjectedWindow& window) {
     const size_t n = window.size;
-    const size_t chunks = std::clamp<size_t>(n / 16384, 1, 64), per = (n + chunks - 1) / chunks;
+    const size_t chunks = std::clamp<size_t>(n / 4096, 1, 64), per = (n + chunks - 1) / chunks;
     const uint32_t* orderOf = window.order.data();
     const float* depthOf = window.depth.data();
     // Per chunk: drawable primitives and the range of their keys (8 bytes read per primitive).
@@ -248,7 +248,7 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
 /// prefix sums, fill; the lists do not depend on the chunking.
 SkippedPrimitives TileCompositor::binToTiles() {
     const size_t tiles = size_t(tilesX_) * tilesY_, n = orderCount_;
-    const size_t chunks = std::clamp<size_t>(n / 16384, 1, 16), per = (n + chunks - 1) / chunks;
+    const size_t chunks = std::clamp<size_t>(n / 4096, 1, 64), per = (n + chunks - 1) / chunks;
     std::vector<uint32_t>& counts = binCounts_;  // reused: fresh pages cost a fault each on every window
     counts.assign(chunks * tiles, 0);
     std::vector<SkippedPrimitives> skippedIn(chunks);
