@@ -144,23 +144,26 @@ Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, const ProjectionC
     return p;
 }
 
-/// makeSplat's primitive from lane @p k of a projectSplatsVector call (the same fields).
-Primitive splatFromLane(const SplatLanes& lanes, size_t k, const glm::vec3& viewPos, float sigma, const glm::vec3& color,
-                        const ProjectionContext& ctx) {
-    Primitive p;
-    p.viewPos = viewPos;
-    p.sigma = sigma;
+/// makeSplat's splat from lane @p k of a projectSplatsVector call, stored straight into
+/// @p window as primitive @p i (the fields set() would write from that Primitive; no Primitive
+/// is built). Returns its kind (Culled when it has no pixel on the image) and sets @p range.
+PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const VoxelBatch& batch, int64_t slab,
+                             const ProjectionContext& ctx, ProjectedWindow& window, PixelRange& range) {
     const uint8_t status = lanes.status[k];
-    p.kind = status & SplatLanes::kExactIndex ? PrimitiveKind::SplatExactIndex : PrimitiveKind::Splat;
-    p.centre = glm::vec2(float(lanes.centreX[k]), float(lanes.centreY[k]));
-    p.conic = glm::vec3(float(lanes.conicXX[k]), float(lanes.conicXY[k]), float(lanes.conicYY[k]));
-    p.scale = float(sigma * lanes.amplitude[k]);
-    p.sin2Alpha = float(lanes.sinAlpha[k] * lanes.sinAlpha[k]);
-    if (p.kind == PrimitiveKind::SplatExactIndex) p.exactMap = lanes.exactMap(k), p.hasExactMap = true;
-    p.range = lanes.range(k);
-    if (status & SplatLanes::kOffImage) p.kind = PrimitiveKind::Culled;
-    p.color = ctx.showPrimitives ? splatTint(color) : color;
-    return p;
+    PrimitiveRecord q;
+    q.kind = status & SplatLanes::kOffImage       ? PrimitiveKind::Culled
+             : status & SplatLanes::kExactIndex ? PrimitiveKind::SplatExactIndex
+                                                : PrimitiveKind::Splat;
+    q.hasExactMap = (status & SplatLanes::kExactIndex) != 0;  // as makeSplat: kept when culled
+    q.centre = glm::vec2(float(lanes.centreX[k]), float(lanes.centreY[k]));
+    q.shape = glm::vec3(float(lanes.conicXX[k]), float(lanes.conicXY[k]), float(lanes.conicYY[k]));
+    q.scale = float(batch.sigma[i] * lanes.amplitude[k]);
+    q.sin2Alpha = float(lanes.sinAlpha[k] * lanes.sinAlpha[k]);
+    q.color = ctx.showPrimitives ? splatTint(batch.color[i]) : batch.color[i];
+    q.range = range = lanes.range(k);
+    window.store(i, q, slab, batch.distance[i], batch.members[i]);
+    if (q.kind == PrimitiveKind::SplatExactIndex) window.extra[i] = PrimitiveExtra{lanes.exactMap(k), batch.viewPos[i], batch.sigma[i]};
+    return q.kind;
 }
 
 }  // namespace
@@ -241,28 +244,37 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                     for (size_t k = chunkEnd - chunk; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
                     projectSplatsVector(lanes, chunkEnd - chunk, *laneContext);
                 }
-                Primitive p = laneContext && lanes.status[i - chunk] != SplatLanes::kScalar
-                                  ? splatFromLane(lanes, i - chunk, batch.viewPos[i], batch.sigma[i], batch.color[i], ctx)
-                                  : projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
-                p.members = batch.members[i];
-                p.depth = batch.distance[i];
-                p.slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
-                                             batch.slabEnd - 1);
-                if (ctx.slabs.on && p.kind != PrimitiveKind::Culled)
-                    p.profile = slabProfileFor(glm::dvec3(batch.viewPos[i]), batch.distance[i], p.slab,
-                                               batch.depthSpread.empty() ? 0.f : batch.depthSpread[i], ctx);
-                window.set(i, p);
-                if (p.kind == PrimitiveKind::Culled) continue;
-                ++(p.kind == PrimitiveKind::Point ? c.points : c.splats);
-                if (p.kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
-                c.drawnVoxels += p.members;
-                if (p.members > 1) ++c.lodAggregates, c.lodVoxels += p.members;
-                if (ctx.occlusion && !p.range.empty() &&
-                    ctx.occlusion->hidden(p.range.x0, p.range.y0, p.range.x1, p.range.y1)) {
+                const int64_t slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
+                                                         batch.slabEnd - 1);
+                PrimitiveKind kind;
+                PixelRange range;
+                if (laneContext && lanes.status[i - chunk] != SplatLanes::kScalar) {
+                    kind = storeLaneSplat(lanes, i - chunk, i, batch, slab, ctx, window, range);
+                    if (ctx.slabs.on && kind != PrimitiveKind::Culled)
+                        window.profile[i] = slabProfileFor(glm::dvec3(batch.viewPos[i]), batch.distance[i], slab,
+                                                           batch.depthSpread.empty() ? 0.f : batch.depthSpread[i], ctx);
+                } else {
+                    Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
+                    p.members = batch.members[i];
+                    p.depth = batch.distance[i];
+                    p.slab = slab;
+                    if (ctx.slabs.on && p.kind != PrimitiveKind::Culled)
+                        p.profile = slabProfileFor(glm::dvec3(batch.viewPos[i]), batch.distance[i], p.slab,
+                                                   batch.depthSpread.empty() ? 0.f : batch.depthSpread[i], ctx);
+                    window.set(i, p);
+                    kind = p.kind, range = p.range;
+                }
+                if (kind == PrimitiveKind::Culled) continue;
+                const uint32_t members = batch.members[i];
+                ++(kind == PrimitiveKind::Point ? c.points : c.splats);
+                if (kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
+                c.drawnVoxels += members;
+                if (members > 1) ++c.lodAggregates, c.lodVoxels += members;
+                if (ctx.occlusion && !range.empty() && ctx.occlusion->hidden(range.x0, range.y0, range.x1, range.y1)) {
                     window.order[i] = ProjectedWindow::kNotDrawn;
-                    ++(p.kind == PrimitiveKind::Point ? c.hidden.points : c.hidden.splats);
-                    if (p.kind == PrimitiveKind::SplatExactIndex) ++c.hidden.exactIndexSplats;
-                    c.hidden.voxels += p.members;
+                    ++(kind == PrimitiveKind::Point ? c.hidden.points : c.hidden.splats);
+                    if (kind == PrimitiveKind::SplatExactIndex) ++c.hidden.exactIndexSplats;
+                    c.hidden.voxels += members;
                 }
             }
             return c;
