@@ -186,13 +186,11 @@ SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, doubl
     return skipped;
 }
 
-/// One global sort by (key, index), then a gather: every tile's list comes out in order
-/// without a per-tile sort, and the tiles read their primitives sequentially (indexing the
-/// window in key order was a cache miss per primitive at far views). The key passes and the
-/// gather (binToTiles) are parallel over fixed chunks of the window; the sort is a parallel radix sort of
-/// the packed keys (KeyLayout: typically 20–30 bits, 3–4 passes, several times faster than a
-/// comparison sort of the 16-byte entries). Nothing depends on the thread count; what is
-/// gathered is the 64-byte TileRecord, not the Primitive.
+/// One global sort by (key, index), then binning in that order: every tile's list comes out in
+/// order without a per-tile sort. The key passes and the binning (binToTiles) are parallel over
+/// fixed chunks of the window; the sort is a parallel radix sort of the packed keys (KeyLayout:
+/// typically 20–30 bits, 3–4 passes, several times faster than a comparison sort of the 16-byte
+/// entries). Nothing depends on the thread count.
 void TileCompositor::sortWindow(const ProjectedWindow& window) {
     const size_t n = window.size;
     const size_t chunks = std::clamp<size_t>(n / 4096, 1, 64), per = (n + chunks - 1) / chunks;
@@ -229,8 +227,7 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
     }
     // Buffers grow only (default-initialised: nothing is written until the parallel passes).
     growDiscarding(order_, total), growDiscarding(sortScratch_, total);
-    growDiscarding(records_, total), growDiscarding(maps_, total);
-    if (window.profiles) growDiscarding(profiles_, total);
+    growDiscarding(ranges_, total);
     orderCount_ = total;
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         size_t k = cursor[c];
@@ -239,13 +236,15 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
     });
     // order_ is in index order; the stable sort by key makes it the total (key, index) order.
     if (radixSort(order_.data(), sortScratch_.data(), total, layout.bits) != order_.data()) std::swap(order_, sortScratch_);
-    // The records are gathered in this order by binToTiles' first pass.
+    // binToTiles bins the primitives in this order.
 }
 
-/// Gathers the window's records into records_ in sorted order and bins them into per-tile lists
-/// (CSR: binStart_, binEntries_), each list ascending in sorted position, skipping tiles that are
-/// already opaque. Parallel over fixed chunks of records_: gather and count per (chunk, tile),
-/// prefix sums, fill; the lists do not depend on the chunking.
+/// Bins the window's primitives, in sorted order, into per-tile lists of window indices (CSR:
+/// binStart_, binEntries_), skipping tiles that are already opaque. Parallel over fixed chunks of
+/// the sorted order: read each record's range (a random line; gathered into ranges_) and count
+/// per (chunk, tile), prefix sums, fill; the lists do not depend on the chunking. The tiles then
+/// read the window's records in place, a prefetched line each (session 11: gathering the 64-byte
+/// records, the exact-index maps and the slab profiles into sorted copies cost more than it saved).
 SkippedPrimitives TileCompositor::binToTiles() {
     const size_t tiles = size_t(tilesX_) * tilesY_, n = orderCount_;
     const size_t chunks = std::clamp<size_t>(n / 4096, 1, 64), per = (n + chunks - 1) / chunks;
@@ -260,7 +259,7 @@ SkippedPrimitives TileCompositor::binToTiles() {
                 if (liveCount_[tile] > 0) fn(tile);
             }
     };
-    // Gather the records in sorted order (and the exact-index maps), counting each one's tiles.
+    // Each primitive's range, in sorted order, and the tiles it counts in.
     const ProjectedWindow& window = *window_;
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         uint32_t* count = counts.data() + c * tiles;
@@ -269,9 +268,8 @@ SkippedPrimitives TileCompositor::binToTiles() {
         for (size_t k = c * per; k < end; ++k) {
             if (k + 8 < end) __builtin_prefetch(&window.records[order_[k + 8].index]);  // a random line each
             const uint32_t i = order_[k].index;
-            const TileRecord& p = records_[k] = window.records[i];
-            if (p.hasExactMap) maps_[k] = window.extra[i].exactMap;
-            if (window.profiles) profiles_[k] = window.profile[i];
+            const TileRecord& p = window.records[i];
+            ranges_[k] = p.range;
             bool any = false;
             forTiles(p.range, [&](size_t tile) { ++count[tile], any = true; });
             if (!any) {
@@ -297,7 +295,7 @@ SkippedPrimitives TileCompositor::binToTiles() {
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         uint32_t* cursor = counts.data() + c * tiles;
         for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k)
-            forTiles(records_[k].range, [&](size_t tile) { binEntries_[cursor[tile]++] = uint32_t(k); });
+            forTiles(ranges_[k], [&](size_t tile) { binEntries_[cursor[tile]++] = order_[k].index; });
     });
     SkippedPrimitives skipped;
     for (const SkippedPrimitives& s : skippedIn) {
@@ -382,21 +380,21 @@ void compositeSlab(Pixels& px, Slab& slab, bool skipFinished = false) {
 }
 }  // namespace
 
-void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t k, TilePixels& px, SlabBuffer* slab,
+void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t i, TilePixels& px, SlabBuffer* slab,
                                    const SlabTargets* slabs) const {
     switch (p.kind) {
         case PrimitiveKind::Point: drawPoint(p, px, slab, slabs); break;
-        case PrimitiveKind::Splat: drawSplat(p, maps_[k], px, slabs); break;
+        case PrimitiveKind::Splat: drawSplat(p, window_->extra[i].exactMap, px, slabs); break;  // the map unread
         case PrimitiveKind::SplatExactIndex:  // without its map: the half-ray fallback
-            p.hasExactMap ? drawSplat(p, maps_[k], px, slabs) : drawExact(p, window_->extra[order_[k].index], px, slabs);
+            p.hasExactMap ? drawSplat(p, window_->extra[i].exactMap, px, slabs) : drawExact(p, window_->extra[i], px, slabs);
             break;
         case PrimitiveKind::SplatExact:
-        case PrimitiveKind::NearEye: drawExact(p, window_->extra[order_[k].index], px, slabs); break;
+        case PrimitiveKind::NearEye: drawExact(p, window_->extra[i], px, slabs); break;
         case PrimitiveKind::Culled: break;
     }
 }
 
-/// Records are a cache miss each (a tile's list is sparse in records_): fetch them (and, in the
+/// Records are a cache miss each (a tile's list is sparse in the window): fetch them (and, in the
 /// slab order, their profiles) 8 ahead, and an exact-index splat's map (two lines) 4 ahead, once
 /// its record has arrived.
 inline void TileCompositor::prefetchAhead(std::span<const uint32_t> entries, size_t e, bool profiles) const {
@@ -404,14 +402,14 @@ inline void TileCompositor::prefetchAhead(std::span<const uint32_t> entries, siz
     // The prefetches are written out here, not in a helper lambda: GCC compiled the lambda out of
     // line, found it free of side effects and dropped its calls, as it did this whole function.
     if (e + kAhead < entries.size()) {
-        __builtin_prefetch(&records_[entries[e + kAhead]]);
+        __builtin_prefetch(&window_->records[entries[e + kAhead]]);
         if (profiles) {
-            const char* c = reinterpret_cast<const char*>(&profiles_[entries[e + kAhead]]);
+            const char* c = reinterpret_cast<const char*>(&window_->profile[entries[e + kAhead]]);
             __builtin_prefetch(c), __builtin_prefetch(c + sizeof(SlabProfile) - 1);
         }
     }
-    if (e + kMapAhead < entries.size() && records_[entries[e + kMapAhead]].hasExactMap) {
-        const char* c = reinterpret_cast<const char*>(&maps_[entries[e + kMapAhead]]);
+    if (e + kMapAhead < entries.size() && window_->records[entries[e + kMapAhead]].hasExactMap) {
+        const char* c = reinterpret_cast<const char*>(&window_->extra[entries[e + kMapAhead]].exactMap);
         __builtin_prefetch(c), __builtin_prefetch(c + sizeof(ExactIndexMap) - 1);
     }
 }
@@ -423,8 +421,8 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
     int64_t slabOf = std::numeric_limits<int64_t>::min();
     for (size_t e = 0; e < entries.size(); ++e) {
         prefetchAhead(entries, e, false);
-        const uint32_t k = entries[e];
-        const TileRecord& p = records_[k];
+        const uint32_t i = entries[e];
+        const TileRecord& p = window_->records[i];
         const bool isPoint = p.kind == PrimitiveKind::Point;
         if (int64_t(p.slab) != slabOf || !isPoint) {
             compositeSlab(px, slab);
@@ -432,7 +430,7 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
         }
         // Tile-level early termination, checked every 32 primitives.
         if ((e & 31) == 31 && !slab.dirty && px.countLive() == 0) break;
-        drawPrimitive(p, k, px, &slab, nullptr);
+        drawPrimitive(p, i, px, &slab, nullptr);
     }
     compositeSlab(px, slab);
     storeTile(tile, px);
@@ -457,15 +455,15 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entr
     const int64_t base = window_->slabBase;
     for (size_t e = 0; e < entries.size(); ++e) {
         prefetchAhead(entries, e, true);
-        const uint32_t k = entries[e];
-        const TileRecord& p = records_[k];
+        const uint32_t i = entries[e];
+        const TileRecord& p = window_->records[i];
         const int64_t slab = base + int64_t(p.slab);
         closeUpTo(slab - reach);
         // Tile-level early termination, checked every 32 primitives (open slabs of finished
         // pixels add at most ε·c; they are composited below all the same).
         if ((e & 31) == 31 && px.countLive() == 0) break;
-        const SlabTargets targets = ring.targets(profiles_[k], slab, reach);
-        if (targets.count > 0) drawPrimitive(p, k, px, nullptr, &targets);
+        const SlabTargets targets = ring.targets(window_->profile[i], slab, reach);
+        if (targets.count > 0) drawPrimitive(p, i, px, nullptr, &targets);
     }
     closeUpTo(closeBefore);
     const bool opaque = px.countLive() == 0;

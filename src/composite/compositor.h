@@ -124,7 +124,7 @@ private:
     void compositeTile(int tile, std::span<const uint32_t> entries);
     void compositeTileSlabs(int tile, std::span<const uint32_t> entries, int64_t closeBefore);
     void closeSlab(TilePixels& px, SlabBuffer& slab) const;  // one "over" per live pixel, then empty
-    void drawPrimitive(const TileRecord& p, uint32_t k, TilePixels& px, SlabBuffer* slab, const SlabTargets* slabs) const;
+    void drawPrimitive(const TileRecord& p, uint32_t i, TilePixels& px, SlabBuffer* slab, const SlabTargets* slabs) const;
     void drawPoint(const TileRecord& p, const TilePixels& tile, SlabBuffer* slab, const SlabTargets* slabs) const;
     void drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile, const SlabTargets* slabs) const;
     void drawSplatTables(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile, const SlabTargets* slabs) const;
@@ -145,12 +145,10 @@ private:
     size_t orderCount_ = 0;               // the window's drawable primitives (the buffers grow only)
     Buffer<Entry> order_;                 // the window's drawable primitives in (key, index) order
     Buffer<Entry> sortScratch_;           // the radix sort's second buffer
-    Buffer<TileRecord> records_;          // ... gathered in that order
-    Buffer<ExactIndexMap> maps_;          // ... their exact-index maps, where hasExactMap
-    Buffer<SlabProfile> profiles_;        // ... their slab fractions (--compositing slabs)
+    Buffer<PixelRange> ranges_;           // ... their pixel ranges, gathered in that order
     std::vector<size_t> chunkCounts_;     // sortWindow's per-chunk counts and cursors
     std::vector<size_t> binStart_;        // per tile (+1): its list in binEntries_
-    Buffer<uint32_t> binEntries_;    // per tile: positions in records_, ascending
+    Buffer<uint32_t> binEntries_;         // per tile: window indices, in (key, index) order
     std::vector<uint32_t> binCounts_;     // binToTiles' per-(chunk, tile) counts and cursors
 };
 
