@@ -25,17 +25,21 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 
 /// The order of a window: slab, then points before splats, then depth (then the primitive's
 /// index, which the stable sort keeps). Packed into as few bits as the window's range needs:
-///     key = ((slab − slabBase) · 2 + kind) · 2^depthBits + (depth bits − depthBase)
+///     key = ((slab − slabBase) · 2 + kind) · 2^depthBits + ((depth bits − depthBase) >> depthShift)
 /// with the depth's float bits (monotone for floats ≥ 0), so the radix sort makes few passes.
+/// The key sits above the index in a 64-bit entry; depthShift drops the depth's lowest bits
+/// only where key and index would not fit (a window spanning more than ~2^(64 − index bits −
+/// slab bits) float steps of depth: never in the test scenes; ties then go by index).
 struct KeyLayout {
     uint32_t orderBase = 0;  ///< the smallest ProjectedWindow::order (relative slab·2 + kind)
     uint32_t depthBase = 0;
     int depthBits = 0;
+    int depthShift = 0;
     int bits = 0;  ///< the key's width
 
     static uint32_t depthOf(float depth) { return std::bit_cast<uint32_t>(std::max(depth, 0.f)); }
     uint64_t key(uint32_t order, float depth) const {
-        return (uint64_t(order - orderBase) << depthBits) | (depthOf(depth) - depthBase);
+        return (uint64_t(order - orderBase) << depthBits) | ((depthOf(depth) - depthBase) >> depthShift);
     }
 };
 
@@ -46,28 +50,27 @@ struct ChunkRange {
     uint32_t depthLo = std::numeric_limits<uint32_t>::max(), depthHi = 0;
 };
 
-/// Stable LSD radix sort of the @p n entries at @p a by key, 8 bits a pass over the key's
-/// low @p bits, ping-ponging with @p scratch (n entries); returns where the result is (a or
+/// Stable LSD radix sort of the @p n 64-bit entries at @p a by their bits [@p low, @p low + @p bits),
+/// 8 bits a pass, ping-ponging with @p scratch (n entries); returns where the result is (a or
 /// scratch). Each pass is parallel over fixed chunks: per-chunk digit counts, offsets digit by
 /// digit then chunk by chunk, scatter. Stable, so entries with equal keys keep their (index)
 /// order, and the chunks are fixed by n, so the result does not depend on the thread count.
-template <class Entry>
-Entry* radixSort(Entry* a, Entry* scratch, size_t n, int bits) {
+uint64_t* radixSort(uint64_t* a, uint64_t* scratch, size_t n, int low, int bits) {
     const size_t chunks = std::clamp<size_t>(n / 4096, 1, 64), per = (n + chunks - 1) / chunks;
     std::vector<std::array<size_t, 256>> start(chunks);
-    Entry *from = a, *to = scratch;
-    for (int shift = 0; shift < bits; shift += 8) {
+    uint64_t *from = a, *to = scratch;
+    for (int shift = low; shift < low + bits; shift += 8) {
         tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
             std::array<size_t, 256>& count = start[c];
             count.fill(0);
-            for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) ++count[(from[i].key >> shift) & 0xff];
+            for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) ++count[(from[i] >> shift) & 0xff];
         });
         size_t total = 0;
         for (size_t digit = 0; digit < 256; ++digit)
             for (size_t c = 0; c < chunks; ++c) total += std::exchange(start[c][digit], total);
         tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
             std::array<size_t, 256>& cursor = start[c];
-            for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) to[cursor[(from[i].key >> shift) & 0xff]++] = from[i];
+            for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) to[cursor[(from[i] >> shift) & 0xff]++] = from[i];
         });
         std::swap(from, to);
     }
@@ -222,8 +225,12 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
     if (total > 0) {
         // order = relative slab·2 + kind: the slab's bits and the kind's one.
         layout.orderBase = all.orderLo & ~1u, layout.depthBase = all.depthLo;
-        layout.depthBits = int(std::bit_width(all.depthHi - all.depthLo));
-        layout.bits = int(std::bit_width(all.orderHi - layout.orderBase)) + layout.depthBits;
+        const int orderBits = int(std::bit_width(all.orderHi - layout.orderBase));
+        const int depthBits = int(std::bit_width(all.depthHi - all.depthLo));
+        indexBits_ = std::max(1, int(std::bit_width(n - 1)));
+        layout.depthShift = std::max(0, orderBits + depthBits - (64 - indexBits_));
+        layout.depthBits = depthBits - layout.depthShift;
+        layout.bits = orderBits + layout.depthBits;
     }
     // Buffers grow only (default-initialised: nothing is written until the parallel passes).
     growDiscarding(order_, total), growDiscarding(sortScratch_, total);
@@ -232,10 +239,11 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         size_t k = cursor[c];
         for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i)
-            if (orderOf[i] != ProjectedWindow::kNotDrawn) order_[k++] = {layout.key(orderOf[i], depthOf[i]), uint32_t(i)};
+            if (orderOf[i] != ProjectedWindow::kNotDrawn) order_[k++] = layout.key(orderOf[i], depthOf[i]) << indexBits_ | i;
     });
     // order_ is in index order; the stable sort by key makes it the total (key, index) order.
-    if (radixSort(order_.data(), sortScratch_.data(), total, layout.bits) != order_.data()) std::swap(order_, sortScratch_);
+    if (radixSort(order_.data(), sortScratch_.data(), total, indexBits_, layout.bits) != order_.data())
+        std::swap(order_, sortScratch_);
     // binToTiles bins the primitives in this order.
 }
 
@@ -266,8 +274,8 @@ SkippedPrimitives TileCompositor::binToTiles() {
         SkippedPrimitives& skipped = skippedIn[c];
         const size_t end = std::min(n, (c + 1) * per);
         for (size_t k = c * per; k < end; ++k) {
-            if (k + 8 < end) __builtin_prefetch(&window.records[order_[k + 8].index]);  // a random line each
-            const uint32_t i = order_[k].index;
+            if (k + 8 < end) __builtin_prefetch(&window.records[indexOf(order_[k + 8])]);  // a random line each
+            const uint32_t i = indexOf(order_[k]);
             const TileRecord& p = window.records[i];
             ranges_[k] = p.range;
             bool any = false;
@@ -275,7 +283,7 @@ SkippedPrimitives TileCompositor::binToTiles() {
             if (!any) {
                 ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
                 if (p.kind == PrimitiveKind::SplatExactIndex) ++skipped.exactIndexSplats;
-                skipped.voxels += window_->members[order_[k].index];
+                skipped.voxels += window_->members[i];
             }
         }
     });
@@ -295,7 +303,7 @@ SkippedPrimitives TileCompositor::binToTiles() {
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         uint32_t* cursor = counts.data() + c * tiles;
         for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k)
-            forTiles(ranges_[k], [&](size_t tile) { binEntries_[cursor[tile]++] = order_[k].index; });
+            forTiles(ranges_[k], [&](size_t tile) { binEntries_[cursor[tile]++] = indexOf(order_[k]); });
     });
     SkippedPrimitives skipped;
     for (const SkippedPrimitives& s : skippedIn) {

@@ -235,6 +235,28 @@ TEST(TileCompositor, OrderWithTiesAndWideKeyRanges) {
     EXPECT_LT(maxDifference(scalar, slow), 1e-5);
 }
 
+// Key and index share one 64-bit sort entry; where they would not fit, the key drops the depth's
+// lowest bits. Forced here: slabs spread over 2^27 (28 bits of slab and kind), depths from 0 to
+// 10⁶ (31 bits), 3 000 primitives (12 bits) make 71 bits, so 7 depth bits go. Every depth is
+// distinct by far more than that (≥ 3·10⁻⁴ of it, the dropped bits 2⁻¹⁶), so the order, and the
+// image, must still be the slow compositor's; a key that spilled into the index would scramble it.
+TEST(TileCompositor, OrderWhenKeyAndIndexOverflowOneWord) {
+    const Camera camera = testCamera(72);
+    auto windows = randomWindows(camera, RenderMode::Hybrid);
+    for (auto& w : windows)
+        for (size_t i = 0; i < w.size(); ++i) {
+            Primitive& p = w[i];
+            p.depth = 20.f + 0.01f * float(i);  // distinct, 3·10⁻⁴ apart at most relative
+            p.slab = int64_t(std::floor(p.depth / 0.1f));
+            if (i == 7) p.depth = 0.f, p.slab = 0;
+            if (i == 11) p.depth = 1.0e6f, p.slab = (int64_t(1) << 27) - 2;
+        }
+    const Image slow = slowComposite(windows, camera.width(), camera.height());
+    const Image scalar = fastComposite(windows, camera, false);
+    std::printf("  scalar vs slow: %.2g\n", maxDifference(scalar, slow));
+    EXPECT_LT(maxDifference(scalar, slow), 1e-5);
+}
+
 // The compositor's image is the same, bit for bit, whatever the thread count.
 TEST(TileCompositor, SameImageForAnyThreadCount) {
     const Camera camera = testCamera(72);
