@@ -123,7 +123,7 @@ struct ProjectedWindow {
     /// Stores @p p as primitive @p i (its slab relative to slabBase, clamped to [0, kMaxRelativeSlab]).
     void set(size_t i, const Primitive& p) {
         const bool point = p.kind == PrimitiveKind::Point;
-        PrimitiveRecord q;
+        PrimitiveRecord& q = records[i];
         q.centre = p.centre;
         q.shape = point ? glm::vec3(p.pointInvVariance, p.total, p.pointNorm) : p.conic;
         q.scale = point ? p.pointRadius2 : p.scale;
@@ -132,18 +132,18 @@ struct ProjectedWindow {
         q.range = p.range;
         q.kind = p.kind;
         q.hasExactMap = p.hasExactMap;
-        store(i, q, p.slab, p.depth, p.members);
+        place(i, p.slab, p.depth, p.members);
         if (needsExtra(p.kind)) extra[i] = PrimitiveExtra{p.exactMap, p.viewPos, p.sigma};
         if (profiles) profile[i] = p.profile;
     }
-    /// Stores record @p q (all but its slab set) as primitive @p i of slab @p absoluteSlab: what
-    /// set() writes apart from the rare kinds' extra data and the profile, which the caller
-    /// writes where they apply (the projection's lane path stores its splats this way, without
-    /// building a Primitive).
-    void store(size_t i, PrimitiveRecord q, int64_t absoluteSlab, float distance, uint32_t voxels) {
+    /// The rest of primitive @p i once records[i] holds all but its slab (set() does this; the
+    /// projection's lane path writes its splats' records in place and then calls this, without
+    /// building a Primitive: a record built aside and copied stalled on store forwarding):
+    /// its slab @p absoluteSlab, its order key, @p distance and @p voxels.
+    void place(size_t i, int64_t absoluteSlab, float distance, uint32_t voxels) {
+        PrimitiveRecord& q = records[i];
         const uint32_t slab = uint32_t(std::clamp<int64_t>(absoluteSlab - slabBase, 0, kMaxRelativeSlab));
         q.slab = slab;
-        records[i] = q;
         const bool drawn = q.kind != PrimitiveKind::Culled && !q.range.empty();
         order[i] = drawn ? slab << 1 | (q.kind == PrimitiveKind::Point ? 0u : 1u) : kNotDrawn;
         depth[i] = distance;

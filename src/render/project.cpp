@@ -150,10 +150,11 @@ Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, const ProjectionC
 PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const VoxelBatch& batch, int64_t slab,
                              const ProjectionContext& ctx, ProjectedWindow& window, PixelRange& range) {
     const uint8_t status = lanes.status[k];
-    PrimitiveRecord q;
-    q.kind = status & SplatLanes::kOffImage       ? PrimitiveKind::Culled
-             : status & SplatLanes::kExactIndex ? PrimitiveKind::SplatExactIndex
-                                                : PrimitiveKind::Splat;
+    PrimitiveRecord& q = window.records[i];
+    const PrimitiveKind kind = status & SplatLanes::kOffImage     ? PrimitiveKind::Culled
+                               : status & SplatLanes::kExactIndex ? PrimitiveKind::SplatExactIndex
+                                                                  : PrimitiveKind::Splat;
+    q.kind = kind;
     q.hasExactMap = (status & SplatLanes::kExactIndex) != 0;  // as makeSplat: kept when culled
     q.centre = glm::vec2(float(lanes.centreX[k]), float(lanes.centreY[k]));
     q.shape = glm::vec3(float(lanes.conicXX[k]), float(lanes.conicXY[k]), float(lanes.conicYY[k]));
@@ -161,9 +162,9 @@ PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const 
     q.sin2Alpha = float(lanes.sinAlpha[k] * lanes.sinAlpha[k]);
     q.color = ctx.showPrimitives ? splatTint(batch.color[i]) : batch.color[i];
     q.range = range = lanes.range(k);
-    window.store(i, q, slab, batch.distance[i], batch.members[i]);
-    if (q.kind == PrimitiveKind::SplatExactIndex) window.extra[i] = PrimitiveExtra{lanes.exactMap(k), batch.viewPos[i], batch.sigma[i]};
-    return q.kind;
+    window.place(i, slab, batch.distance[i], batch.members[i]);
+    if (kind == PrimitiveKind::SplatExactIndex) window.extra[i] = PrimitiveExtra{lanes.exactMap(k), batch.viewPos[i], batch.sigma[i]};
+    return kind;
 }
 
 }  // namespace
