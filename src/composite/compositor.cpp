@@ -323,6 +323,10 @@ struct TileCompositor::TilePixels {
     alignas(64) std::array<float, kTileSize * kTileSize> G;
     alignas(64) std::array<float, kTileSize * kTileSize> B;
 
+    /// The splat being drawn (drawSplat), its fields set splat by splat: a fresh SplatRaster per
+    /// splat was 168 bytes zeroed (rep stos) each time, a quarter of drawSplat's samples.
+    SplatRaster raster;
+
     static int local(int x, int y, int x0, int y0) { return (y - y0) * kTileSize + (x - x0); }
     int local(int x, int y) const { return local(x, y, x0, y0); }
     bool live(int i) const { return T[size_t(i)] >= kTransmittanceEpsilon; }
@@ -551,7 +555,7 @@ void depositAt(Pixels& px, int i, float tau, const glm::vec3& color, const SlabT
 void TileCompositor::drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& px, const SlabTargets* slabs) const {
     const bool exactIndex = p.kind == PrimitiveKind::SplatExactIndex;
     if (exact_.vector && (exactIndex || tables_.poly.covers(p.sin2Alpha))) {
-        SplatRaster s;
+        SplatRaster& s = px.raster;
         s.cx = p.centre.x, s.cy = p.centre.y;
         s.qxx = p.shape.x, s.qxy = p.shape.y, s.qyy = p.shape.z;
         s.scale = p.scale;

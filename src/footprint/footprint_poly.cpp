@@ -72,16 +72,6 @@ FootprintPolynomials FootprintPolynomials::build(const KernelShape& kernel) {
     return p;
 }
 
-FootprintPolynomials::Coefficients FootprintPolynomials::row(double sin2Alpha) const {
-    const double pos = std::clamp(sin2Alpha / sin2Max_, 0.0, 1.0) * kRows;
-    const int k = std::min(int(pos), kRows - 1);
-    const float w = float(pos - k);
-    const Coefficients &a = rows_[size_t(k)], &b = rows_[size_t(k) + 1];
-    Coefficients c;
-    for (int j = 0; j < kCoefficients; ++j) c[size_t(j)] = a[size_t(j)] + w * (b[size_t(j)] - a[size_t(j)]);
-    return c;
-}
-
 float FootprintPolynomials::evaluate(const Coefficients& c, float t) {
     if (!(t < 1.0f)) return 0.0f;
     t = std::max(t, 0.0f);

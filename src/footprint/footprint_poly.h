@@ -14,6 +14,7 @@
 // The α = 0 row is F as a function of d² itself: the exact-index path uses it.
 // Measured bound (FootprintPoly tests): |F_poly − F| ≤ kErrorBound·F(0), evaluated in float.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <vector>
 
@@ -37,7 +38,15 @@ public:
     /// @brief True when a splat of half cone angle with sin²α = @p sin2Alpha is covered.
     bool covers(double sin2Alpha) const { return sin2Alpha >= 0.0 && sin2Alpha <= sin2Max_; }
     /// @brief The coefficients for sin²α = @p sin2Alpha (must be covered): rows interpolated linearly.
-    Coefficients row(double sin2Alpha) const;
+    Coefficients row(double sin2Alpha) const {  // inline: the splat loop's caller keeps it in registers
+        const double pos = std::clamp(sin2Alpha / sin2Max_, 0.0, 1.0) * kRows;
+        const int k = std::min(int(pos), kRows - 1);
+        const float w = float(pos - k);
+        const Coefficients &a = rows_[size_t(k)], &b = rows_[size_t(k) + 1];
+        Coefficients c;
+        for (int j = 0; j < kCoefficients; ++j) c[size_t(j)] = a[size_t(j)] + w * (b[size_t(j)] - a[size_t(j)]);
+        return c;
+    }
     /// @brief The α = 0 row: F as a polynomial in d² (for the exact-index path).
     const Coefficients& axisRow() const { return rows_.front(); }
 
