@@ -41,6 +41,7 @@
 #include "volume/emission.h"
 #include "image/image.h"
 #include "metrics/metrics.h"
+#include "render/forward_buffers.h"
 #include "render/render.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -476,6 +477,9 @@ int runAnimate(const Args& args) {
 
     const bool tty = ::isatty(2) == 1;
     InterruptGuard guard;
+    ForwardBuffers buffers;  // kept from frame to frame (render/forward_buffers.h)
+    RenderControl control;
+    control.buffers = &buffers;
     const auto start = std::chrono::steady_clock::now();
     auto lastCsv = start;
     size_t done = 0, rendered = 0, skipped = 0;
@@ -499,7 +503,7 @@ int runAnimate(const Args& args) {
                 RenderSettings r = s;
                 r.mode = RenderMode::Reference;
                 RenderStats rs;
-                Image im = render(volume, tf, r, rs);
+                Image im = render(volume, tf, r, rs, control);
                 writeImage(refPath.string(), im,
                            {{"settings", r.toJson().dump()}, {"camera", cameras[i].describe()}, {"mode", "reference"}});
                 referenceImage = std::move(im);
@@ -511,7 +515,7 @@ int runAnimate(const Args& args) {
             ++skipped;
         } else {
             RenderStats st;
-            const Image im = render(volume, tf, s, st);
+            const Image im = render(volume, tf, s, st, control);
             writeImage(framePath.string(), im,
                        {{"settings", s.toJson().dump()},
                         {"camera", cameras[i].describe()},

@@ -28,6 +28,7 @@
 #include "cli/commands.h"
 #include "cli/render_flags.h"
 #include "volume/emission.h"
+#include "render/forward_buffers.h"
 #include "render/render.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -202,6 +203,11 @@ int runBench(const Args& args) {
     for (double d : o.distances)
         for (RenderMode m : o.modes) cells.push_back(Cell{d, m, {}, {}, {}, {}, {}, {}, std::nullopt});
 
+    // The renders keep their buffers from one to the next, as animate and study do: a run's
+    // time is the render's, not the first touch of ~40 MB of fresh memory (forward_buffers.h).
+    ForwardBuffers buffers;
+    RenderControl control;
+    control.buffers = &buffers;
     const int rounds = o.warmup + o.runs;
     for (int r = 0; r < rounds; ++r) {
         const bool timed = r >= o.warmup;
@@ -209,7 +215,7 @@ int runBench(const Args& args) {
             for (size_t mi = 0; mi < o.modes.size(); ++mi) {
                 Cell& cell = cells[di * o.modes.size() + mi];
                 RenderStats stats;
-                (void)render(volume, tf, o.settingsFor(cell.distance, cell.mode), stats);
+                (void)render(volume, tf, o.settingsFor(cell.distance, cell.mode), stats, control);
                 if (o.verbose)
                     std::fprintf(stderr, "%s %d/%d  distance %-6s %-9s %.4f s\n", timed ? "run   " : "warmup",
                                  timed ? r - o.warmup + 1 : r + 1, timed ? o.runs : o.warmup,

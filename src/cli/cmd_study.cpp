@@ -37,6 +37,7 @@
 #include "cli/render_flags.h"
 #include "image/image.h"
 #include "metrics/metrics.h"
+#include "render/forward_buffers.h"
 #include "render/render.h"
 #include "study/error_map.h"
 #include "study/report.h"
@@ -635,6 +636,8 @@ int runStudy(const Args& given) {
     n.total = volumes.size() * o.kernels.size() * o.views.size() * (o.modes.size() + 1);
     RenderControl control;
     control.stop = [&guard] { return guard.interrupted(); };
+    ForwardBuffers buffers;  // kept from render to render (render/forward_buffers.h)
+    control.buffers = &buffers;
     const auto start = std::chrono::steady_clock::now();
     try {
         for (const LoadedVolume& lv : volumes) {

@@ -122,12 +122,17 @@ struct TileCompositor::SlabRing {
     }
 };
 
-TileCompositor::TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs)
+TileCompositor::TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs,
+                               CompositorBuffers* buffers)
     : width_(width), height_(height), tilesX_((width + kTileSize - 1) / kTileSize),
       tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact), slabs_(slabs),
-      color_(size_t(width) * height), transmittance_(size_t(width) * height),  // filled below, in parallel
-      liveCount_(size_t(tilesX_) * tilesY_) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, color_.size(), 16384), [&](const tbb::blocked_range<size_t>& r) {
+      own_(buffers ? nullptr : std::make_unique<CompositorBuffers>()), kept_(buffers ? *buffers : *own_),
+      color_(kept_.color), transmittance_(kept_.transmittance), liveCount_(size_t(tilesX_) * tilesY_),
+      order_(kept_.order), sortScratch_(kept_.sortScratch), ranges_(kept_.ranges), chunkCounts_(kept_.chunkCounts),
+      binStart_(kept_.binStart), binEntries_(kept_.binEntries), binCounts_(kept_.binCounts) {
+    const size_t pixels = size_t(width) * height;
+    growDiscarding(color_, pixels), growDiscarding(transmittance_, pixels);  // filled here, in parallel
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, 16384), [&](const tbb::blocked_range<size_t>& r) {
         std::fill(color_.begin() + ptrdiff_t(r.begin()), color_.begin() + ptrdiff_t(r.end()), glm::vec3(0.f));
         std::fill(transmittance_.begin() + ptrdiff_t(r.begin()), transmittance_.begin() + ptrdiff_t(r.end()), 1.f);
     });

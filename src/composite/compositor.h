@@ -1,8 +1,8 @@
 // composite/compositor.h — the one EWA-filtered, front-to-back compositor (DESIGN §4, §5).
 // Owns: the frame (premultiplied colour and transmittance per pixel), ordering a
 // window's primitives by a (slab, kind, depth, index) key (a stable radix sort of
-// packed keys) and gathering them as 64-byte tile records, binning those to square
-// screen tiles (composite/tile.h), and compositing every tile's list independently and in parallel:
+// packed keys), binning them in that order to square screen tiles (composite/tile.h),
+// and compositing every tile's list independently and in parallel:
 //   - points of one slab are summed into a slab buffer (optical depth and
 //     σ-weighted colour) and composited when the slab ends, so side-by-side
 //     points never occlude each other;
@@ -60,9 +60,28 @@ struct SkippedPrimitives {
     uint64_t voxels = 0;            ///< active voxels the skipped primitives stand for
 };
 
+/// @brief The compositor's large buffers. A caller rendering many images (bench, animate,
+/// study: render/hybrid.h, ForwardBuffers) keeps them from one render to the next, so their
+/// pages are faulted in once, not once per render. They grow and never shrink, and each is
+/// written before it is read, so an image never depends on what they held before.
+struct CompositorBuffers {
+    template <class T>
+    using Buffer = std::vector<T, HugePageAllocator<T>>;
+    Buffer<glm::vec3> color;        ///< the frame: premultiplied radiance
+    Buffer<float> transmittance;    ///< the frame: T
+    Buffer<uint64_t> order;         ///< a window's sort entries (key above index)
+    Buffer<uint64_t> sortScratch;   ///< the radix sort's second buffer
+    Buffer<PixelRange> ranges;      ///< the binning's ranges, in sorted order
+    Buffer<uint32_t> binEntries;    ///< per tile: window indices
+    std::vector<uint32_t> binCounts;
+    std::vector<size_t> chunkCounts, binStart;
+};
+
 class TileCompositor {
 public:
-    TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs = {});
+    /// @param buffers where the large buffers live (kept by the caller across renders); null: its own.
+    TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs = {},
+                   CompositorBuffers* buffers = nullptr);
     ~TileCompositor();
 
     /// @brief Composites @p window (one depth window, any order) behind everything before.
@@ -135,21 +154,23 @@ private:
     SlabCompositing slabs_;
     std::vector<std::unique_ptr<SlabRing>> rings_;  // --compositing slabs: per tile, null while none is open
     template <class T>
-    using Buffer = std::vector<T, HugePageAllocator<T>>;  // large: in huge pages (util/huge_pages.h)
-    Buffer<glm::vec3> color_;             // premultiplied radiance
-    Buffer<float> transmittance_;
+    using Buffer = CompositorBuffers::Buffer<T>;  // large: in huge pages (util/huge_pages.h)
+    std::unique_ptr<CompositorBuffers> own_;  // the buffers, unless the caller keeps them
+    CompositorBuffers& kept_;             // own_ or the caller's
+    Buffer<glm::vec3>& color_;            // premultiplied radiance (the first width·height)
+    Buffer<float>& transmittance_;
     std::vector<int> liveCount_;          // per tile: pixels with T ≥ ε
     const ProjectedWindow* window_ = nullptr;  // the window being composited (composite()'s argument)
     ProjectedWindow packed_;              // composite(span<const Primitive>)'s window
     size_t orderCount_ = 0;               // the window's drawable primitives (the buffers grow only)
     int indexBits_ = 0;                   // the low bits of an Entry that hold the index
-    Buffer<Entry> order_;                 // the window's drawable primitives in (key, index) order
-    Buffer<Entry> sortScratch_;           // the radix sort's second buffer
-    Buffer<PixelRange> ranges_;           // ... their pixel ranges, gathered in that order
-    std::vector<size_t> chunkCounts_;     // sortWindow's per-chunk counts and cursors
-    std::vector<size_t> binStart_;        // per tile (+1): its list in binEntries_
-    Buffer<uint32_t> binEntries_;         // per tile: window indices, in (key, index) order
-    std::vector<uint32_t> binCounts_;     // binToTiles' per-(chunk, tile) counts and cursors
+    Buffer<Entry>& order_;                // the window's drawable primitives in (key, index) order
+    Buffer<Entry>& sortScratch_;          // the radix sort's second buffer
+    Buffer<PixelRange>& ranges_;          // ... their pixel ranges, gathered in that order
+    std::vector<size_t>& chunkCounts_;    // sortWindow's per-chunk counts and cursors
+    std::vector<size_t>& binStart_;       // per tile (+1): its list in binEntries_
+    Buffer<uint32_t>& binEntries_;        // per tile: window indices, in (key, index) order
+    std::vector<uint32_t>& binCounts_;    // binToTiles' per-(chunk, tile) counts and cursors
 };
 
 }  // namespace vdbsplat

@@ -10,6 +10,7 @@
 #include "composite/compositor.h"
 #include "footprint/kernel.h"
 #include "footprint/pixel_box.h"
+#include "render/forward_buffers.h"
 #include "render/postfilter.h"
 #include "render/project.h"
 #include "volume/stream.h"
@@ -65,7 +66,9 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point ? INFINITY
                                  : drawsOnlySplats(settings.mode)   ? 0.0
                                                                     : pass.threshold;
-    VoxelStream stream(volume, camera, table, streamOptions, shader, emission);
+    ForwardBuffers own;  // empty vectors: nothing allocated unless the caller keeps none
+    ForwardBuffers& buffers = control.buffers ? *control.buffers : own;
+    VoxelStream stream(volume, camera, table, streamOptions, shader, emission, &buffers.stream);
     ExactContext exact{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance};
     exact.shape = &shape;
     // --compositing slabs: a kernel reaches R·(its longest semi-axis per index unit) along any
@@ -75,7 +78,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
         slabs.on = true;
         slabs.reach = slabReachFor(tables.kernel->radius() * shape.sMax / stream.slabLength());
     }
-    TileCompositor compositor(camera.width(), camera.height(), tables, exact, slabs);
+    TileCompositor compositor(camera.width(), camera.height(), tables, exact, slabs, &buffers.compositor);
     ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
                           settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
                           pass.prefilterVariance};
@@ -86,8 +89,8 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     std::optional<MarginalCdfTable> marginal;
     if (slabs.on) ctx.marginal = &marginal.emplace(*tables.kernel);
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
-    VoxelBatch batch;
-    ProjectedWindow window;
+    VoxelBatch& batch = buffers.batch;
+    ProjectedWindow& window = buffers.window;
     uint64_t drawnVoxels = 0;
     while (true) {
         if (control.stop && control.stop()) throw RenderStopped("render stopped");

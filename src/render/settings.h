@@ -169,12 +169,18 @@ struct RenderSettings {
 
 /// @brief How a long render reports progress and learns that it should stop (Ctrl-C).
 /// Both are optional and neither changes the image.
+struct ForwardBuffers;  // render/forward_buffers.h
+
 struct RenderControl {
     /// The fraction of the work done, in [0, 1]; called from rendering threads (thread-safe, cheap).
     std::function<void(double)> progress;
     /// Polled before the work, between depth windows (forward modes) and between rows
     /// (reference); returning true makes render() throw RenderStopped.
     std::function<bool()> stop;
+    /// Buffers the forward modes keep from one render to the next (render/forward_buffers.h):
+    /// a command rendering many images passes one, so their pages are faulted in once; null:
+    /// each render has its own. Not shared by renders running at the same time.
+    ForwardBuffers* buffers = nullptr;
 };
 
 /// @brief Thrown when RenderControl::stop asked the render to end early; nothing was drawn to keep.

@@ -47,9 +47,13 @@ void VoxelBatch::clear() {
 }
 
 VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
-                         const StreamOptions& options, const VoxelShader* shader, const EmissionSource* emission)
+                         const StreamOptions& options, const VoxelShader* shader, const EmissionSource* emission,
+                         StreamBuffers* buffers)
     : volume_(volume), camera_(camera), table_(table), options_(options), shader_(shader), emission_(emission),
-      slabLength_(options.slabThickness * volume.voxelSize), slabsPerWindow_(std::max(1, options.slabsPerWindow)) {
+      slabLength_(options.slabThickness * volume.voxelSize), own_(buffers ? nullptr : std::make_unique<StreamBuffers>()),
+      pending_(buffers ? buffers->pending : own_->pending), pendingNext_(buffers ? buffers->pendingNext : own_->pendingNext),
+      extracted_(buffers ? buffers->extracted : own_->extracted), slabsPerWindow_(std::max(1, options.slabsPerWindow)) {
+    pending_.clear();  // kept buffers: what a stopped render left
     if (volume.activeVoxels > kMaxActiveVoxels)
         throw Error(volume.file + ": grid '" + volume.name + "' has " + std::to_string(volume.activeVoxels) +
                     " active voxels, more than the 2^32 vdbsplat streams");

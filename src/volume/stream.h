@@ -22,6 +22,7 @@
 #pragma once
 #include <functional>
 #include <glm/glm.hpp>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -139,15 +140,25 @@ struct StreamCounts {
     uint64_t aggregatedVoxels = 0;  ///< active voxels they stand for (σ = 0 voxels excluded)
 };
 
+/// @brief The stream's voxel buffers. A caller rendering many images keeps them from one render
+/// to the next (render/hybrid.h, ForwardBuffers): they grow, never shrink, and are emptied or
+/// rewritten before use, so a render never depends on what they held.
+struct StreamBuffers {
+    VoxelBatch pending, pendingNext;
+    std::vector<VoxelBatch> extracted;
+};
+
 class VoxelStream {
 public:
     /// @brief Streams @p volume for @p camera; @p table classifies values.
     /// @throw Error when the grid is too large to stream (more than 2^32 active voxels).
     /// @p shader: shades each voxel after classification (nullptr: unshaded; docs/shading.md).
     /// @p emission: adds each voxel's emission after shading (nullptr: none; docs/emission.md).
+    /// @param buffers where the pending and extracted voxels live (kept by the caller across
+    /// renders, so their pages are faulted in once; StreamBuffers); null: its own.
     VoxelStream(const Volume& volume, const Camera& camera, const ClassificationTable& table,
                 const StreamOptions& options = {}, const VoxelShader* shader = nullptr,
-                const EmissionSource* emission = nullptr);
+                const EmissionSource* emission = nullptr, StreamBuffers* buffers = nullptr);
 
     /// @brief Fills @p batch with the next window front to back; false when the stream is done.
     /// @param hidden optional: returns true for a block whose screen rectangle (pixels,
@@ -195,9 +206,10 @@ private:
     double slabLength_;
     std::vector<Block> blocks_;   // sorted by dMin
     size_t nextBlock_ = 0;
-    VoxelBatch pending_;          // voxels of activated blocks not yet released
-    VoxelBatch pendingNext_;      // the pending voxels a window keeps (swapped with pending_)
-    std::vector<VoxelBatch> extracted_;  // per activated block of the window (reused)
+    std::unique_ptr<StreamBuffers> own_;  // the buffers, unless the caller keeps them
+    VoxelBatch& pending_;         // voxels of activated blocks not yet released
+    VoxelBatch& pendingNext_;     // the pending voxels a window keeps (swapped with pending_)
+    std::vector<VoxelBatch>& extracted_;  // per activated block of the window (reused)
     std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
     std::vector<StreamCounts> blockCounts_;  // per activated block: its aggregates
     int64_t nextSlab_ = 0;

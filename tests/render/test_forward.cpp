@@ -17,6 +17,7 @@
 #include <map>
 
 #include "metrics/metrics.h"
+#include "render/forward_buffers.h"
 #include "render/render.h"
 #include "scenes.h"
 #include "volume/generate.h"
@@ -560,6 +561,42 @@ TEST(Forward, ImagesDoNotDependOnThreadCount) {
         for (size_t i = 0; i < one.pixels.size(); ++i)
             ASSERT_EQ(one.pixels[i], two.pixels[i]) << toString(order) << " " << toString(mode) << " pixel " << i;
     }
+}
+
+// Buffers kept from render to render (bench, animate, study: render/forward_buffers.h) hold what
+// the previous render left: larger or smaller images, other volumes, the slab order's profiles,
+// aggregates. Each render through them must be bit-identical to a fresh one.
+TEST(Forward, KeptBuffersDoNotChangeTheImage) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    const Volume box = boxVolume(openvdb::Coord(0), openvdb::Coord(19), 0.6f);
+    struct Case { const Volume* volume; RenderMode mode; double distance; int size; CompositingOrder order; };
+    const Case cases[] = {
+        {&marschnerLobb(), RenderMode::Splat, 0.35, 128, CompositingOrder::Kernels},  // the largest first
+        {&marschnerLobb(), RenderMode::Hybrid, 1.0, 96, CompositingOrder::Kernels},
+        {&box, RenderMode::Hybrid, 1.0, 64, CompositingOrder::Slabs},
+        {&marschnerLobb(), RenderMode::Hybrid, 8.0, 72, CompositingOrder::Kernels},  // level of detail
+        {&marschnerLobb(), RenderMode::Point, 1.0, 96, CompositingOrder::Kernels},
+        {&box, RenderMode::Splat, 0.5, 160, CompositingOrder::Kernels},  // then larger again
+        {&marschnerLobb(), RenderMode::Hybrid, 1.0, 96, CompositingOrder::Kernels},
+    };
+    ForwardBuffers buffers;
+    RenderControl control;
+    control.buffers = &buffers;
+    for (const Case& c : cases) {
+        RenderSettings s = settingsFor(c.mode, c.distance, c.size);
+        s.compositing = c.order;
+        const Image fresh = renderWith(*c.volume, tf, s);
+        RenderStats stats;
+        const Image kept = render(*c.volume, tf, s, stats, control);
+        ASSERT_EQ(fresh.pixels.size(), kept.pixels.size());
+        double energy = 0.0;
+        for (size_t i = 0; i < fresh.pixels.size(); ++i) {
+            ASSERT_EQ(fresh.pixels[i], kept.pixels[i]) << toString(c.mode) << " " << c.distance << " pixel " << i;
+            energy += fresh.pixels[i].w;
+        }
+        EXPECT_GT(energy, 1.0) << toString(c.mode) << " " << c.distance;  // something was drawn
+    }
+    EXPECT_GT(buffers.window.size, 0u);  // the renders went through the kept buffers
 }
 
 // The same with the level of detail in its passages (voxels → 2³ at distance 2, aggregate levels

@@ -1,0 +1,27 @@
+// render/forward_buffers.h — memory the forward pipeline can keep from one render to the next.
+// Owns: ForwardBuffers, every large buffer of renderForward (render/hybrid.h): the voxel batch,
+// the projected window, the stream's pending and extracted voxels, the compositor's frame, sort
+// and bins. A command that renders many images (bench, animate, study) keeps one and passes it
+// in RenderControl::buffers; a single render needs none.
+//
+// Why: on the virtual machines this project is measured on, the first touch of fresh memory is
+// the cost, not the allocation (util/huge_pages.h). A framed Engine render touches ~40 MB of it;
+// faulted in on every render, it cost ~10 % of the time with two threads and made the projection
+// scale 1.4× instead of 1.9× from one thread to two (docs/performance.md, session 11). The
+// buffers grow and never shrink, and each is written before it is read, so an image never
+// depends on what they held.
+#pragma once
+#include "composite/compositor.h"
+#include "composite/primitive.h"
+#include "volume/stream.h"
+
+namespace vdbsplat {
+
+struct ForwardBuffers {
+    VoxelBatch batch;               ///< one window's voxels
+    ProjectedWindow window;         ///< one window's primitives
+    StreamBuffers stream;           ///< VoxelStream's pending and extracted voxels
+    CompositorBuffers compositor;   ///< TileCompositor's frame, sort and bins
+};
+
+}  // namespace vdbsplat
