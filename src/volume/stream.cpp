@@ -358,19 +358,27 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts)
 void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const {
     const glm::dvec3 origin(b.origin.x(), b.origin.y(), b.origin.z());
     const auto wc = [&](int x, int y, int z) { return coarse ? coarse[size_t(((x >> 1) * 4 + (y >> 1)) * 4 + (z >> 1))] : 0.f; };
+    // Sized for every active voxel first, written by index, cut to the voxels kept: no capacity
+    // check per array and voxel (the buffers do not initialise what resize adds).
+    const size_t first = out.size();
+    out.withDepthSpread = options_.depthSpread;
+    out.resize(first + size_t(openvdb::FloatTree::LeafNodeType::SIZE));  // forEachActive visits at most these
+    size_t k = first;
     forEachActive(b, [&](int x, int y, int z) { return wc(x, y, z) < 1.f; },
                   [&](int x, int y, int z, const Classified& cls) {
         if (!(cls.sigma > 0.f)) return;
         const float c = wc(x, y, z), w = 1.f - c;
         const glm::dvec3 v(indexToView_ * glm::dvec4(origin + glm::dvec3(x, y, z), 1.0));
-        out.viewPos.emplace_back(v);
-        out.distance.push_back(float(glm::length(v)));
-        out.sigma.push_back(w == 1.f ? cls.sigma : cls.sigma * w);
-        out.color.push_back(cls.color);
-        out.spread.push_back(0.f);
-        if (options_.depthSpread) out.depthSpread.push_back(0.f);
-        out.members.push_back(c < 0.5f ? 1 : 0);
+        out.viewPos[k] = glm::vec3(v);
+        out.distance[k] = float(glm::length(v));
+        out.sigma[k] = w == 1.f ? cls.sigma : cls.sigma * w;
+        out.color[k] = cls.color;
+        out.spread[k] = 0.f;
+        if (options_.depthSpread) out.depthSpread[k] = 0.f;
+        out.members[k] = c < 0.5f ? 1 : 0;
+        ++k;
     });
+    out.resize(k);
 }
 
 /// Calls fn(x, y, sigma, color) for every (x, y) row of the block: the row's 8 voxels along z
