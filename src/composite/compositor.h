@@ -126,8 +126,8 @@ private:
     /// (the tie-break) in one word, key << indexBits_ | index: 8 bytes a pass, not 16.
     using Entry = uint64_t;
     uint32_t indexOf(Entry e) const { return uint32_t(e & ((uint64_t(1) << indexBits_) - 1)); }
-    /// What the tile loop reads of one primitive (PrimitiveRecord, one 64-byte line), gathered
-    /// in sort order. The rare kinds that need more (SplatExact, NearEye) read the window's extra.
+    /// What the tile loop reads of one primitive (PrimitiveRecord, one 64-byte line), in place in
+    /// the window. The rare kinds that need more (SplatExact, NearEye) read the window's extra.
     using TileRecord = PrimitiveRecord;
     struct SlabBuffer;
     struct SlabRing;    // --compositing slabs: one tile's open slabs, kept from window to window
@@ -166,7 +166,7 @@ private:
     int indexBits_ = 0;                   // the low bits of an Entry that hold the index
     Buffer<Entry>& order_;                // the window's drawable primitives in (key, index) order
     Buffer<Entry>& sortScratch_;          // the radix sort's second buffer
-    Buffer<PixelRange>& ranges_;          // ... their pixel ranges, gathered in that order
+    Buffer<PixelRange>& ranges_;          // ... their pixel ranges, in that order
     std::vector<size_t>& chunkCounts_;    // sortWindow's per-chunk counts and cursors
     std::vector<size_t>& binStart_;       // per tile (+1): its list in binEntries_
     Buffer<uint32_t>& binEntries_;        // per tile: window indices, in (key, index) order

@@ -32,7 +32,7 @@ enum class PrimitiveKind : uint8_t {
 };
 
 struct Primitive {
-    // What the compositor's key pass and gather read comes first (two cache lines; the
+    // What ProjectedWindow::set reads comes first (two cache lines; the
     // exact-index map and the recompute fields after them are read only for their kinds).
     PrimitiveKind kind = PrimitiveKind::Culled;
     bool hasExactMap = false;   ///< SplatExactIndex: exactMap is set

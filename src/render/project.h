@@ -45,7 +45,7 @@ struct ProjectionContext {
     const VoxelShape* shape = nullptr;
     /// The compositor whose opaque tiles hide primitives (null: none): a primitive whose pixels
     /// all lie in opaque tiles is counted as hidden and not passed on (ProjectionCounts), as the
-    /// compositor's binning would skip it, so it is neither sorted nor gathered.
+    /// compositor's binning would skip it, so it is neither sorted nor binned.
     const TileCompositor* occlusion = nullptr;
     /// Points' filter set up through the vector sum (setupPointVector); false: setupPoint, the
     /// scalar oracle (--simd off). The same values either way.
