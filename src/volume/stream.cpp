@@ -358,11 +358,14 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts)
 void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const {
     const glm::dvec3 origin(b.origin.x(), b.origin.y(), b.origin.z());
     const auto wc = [&](int x, int y, int z) { return coarse ? coarse[size_t(((x >> 1) * 4 + (y >> 1)) * 4 + (z >> 1))] : 0.f; };
-    // Sized for every active voxel first, written by index, cut to the voxels kept: no capacity
-    // check per array and voxel (the buffers do not initialise what resize adds).
+    // Sized for the block's active voxels first (forEachActive visits exactly b.voxels: the
+    // leaf's on-voxel count, or all 512 of a dense leaf or a tile), written by index, cut to the
+    // voxels kept: no capacity check per array and voxel (the buffers do not initialise what
+    // resize adds). By the count, not 512, so a window of sparse blocks stays small (a bound
+    // check per voxel here cost the stream 60 %: 32 → 53 ms on the framed Engine).
     const size_t first = out.size();
     out.withDepthSpread = options_.depthSpread;
-    out.resize(first + size_t(openvdb::FloatTree::LeafNodeType::SIZE));  // forEachActive visits at most these
+    out.resize(first + std::min<size_t>(b.voxels, openvdb::FloatTree::LeafNodeType::SIZE));
     size_t k = first;
     forEachActive(b, [&](int x, int y, int z) { return wc(x, y, z) < 1.f; },
                   [&](int x, int y, int z, const Classified& cls) {
