@@ -43,6 +43,18 @@ struct KeyLayout {
     }
 };
 
+/// The fixed chunks a window's n entries are cut into for the parallel passes (key ranges, radix
+/// sort, binning): by n alone, never by the thread count, so nothing depends on it. 4 096
+/// entries a chunk (up to 64 chunks): 16 384 made a typical 50k-entry window 3 chunks for 2
+/// threads, at most 1.5× (session 11).
+struct Chunks {
+    size_t n, count, per;
+    explicit Chunks(size_t entries)
+        : n(entries), count(std::clamp<size_t>(entries / 4096, 1, 64)), per((entries + count - 1) / count) {}
+    size_t begin(size_t c) const { return c * per; }
+    size_t end(size_t c) const { return std::min(n, (c + 1) * per); }
+};
+
 /// Per chunk of a window: drawable primitives and the range of their slabs and depth bits.
 struct ChunkRange {
     size_t count = 0;
@@ -56,21 +68,21 @@ struct ChunkRange {
 /// digit then chunk by chunk, scatter. Stable, so entries with equal keys keep their (index)
 /// order, and the chunks are fixed by n, so the result does not depend on the thread count.
 uint64_t* radixSort(uint64_t* a, uint64_t* scratch, size_t n, int low, int bits) {
-    const size_t chunks = std::clamp<size_t>(n / 4096, 1, 64), per = (n + chunks - 1) / chunks;
-    std::vector<std::array<size_t, 256>> start(chunks);
+    const Chunks chunks(n);
+    std::vector<std::array<size_t, 256>> start(chunks.count);
     uint64_t *from = a, *to = scratch;
     for (int shift = low; shift < low + bits; shift += 8) {
-        tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+        tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
             std::array<size_t, 256>& count = start[c];
             count.fill(0);
-            for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) ++count[(from[i] >> shift) & 0xff];
+            for (size_t i = chunks.begin(c); i < chunks.end(c); ++i) ++count[(from[i] >> shift) & 0xff];
         });
         size_t total = 0;
         for (size_t digit = 0; digit < 256; ++digit)
-            for (size_t c = 0; c < chunks; ++c) total += std::exchange(start[c][digit], total);
-        tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+            for (size_t c = 0; c < chunks.count; ++c) total += std::exchange(start[c][digit], total);
+        tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
             std::array<size_t, 256>& cursor = start[c];
-            for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) to[cursor[(from[i] >> shift) & 0xff]++] = from[i];
+            for (size_t i = chunks.begin(c); i < chunks.end(c); ++i) to[cursor[(from[i] >> shift) & 0xff]++] = from[i];
         });
         std::swap(from, to);
     }
@@ -201,14 +213,14 @@ SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, doubl
 /// entries). Nothing depends on the thread count.
 void TileCompositor::sortWindow(const ProjectedWindow& window) {
     const size_t n = window.size;
-    const size_t chunks = std::clamp<size_t>(n / 4096, 1, 64), per = (n + chunks - 1) / chunks;
+    const Chunks chunks(n);
     const uint32_t* orderOf = window.order.data();
     const float* depthOf = window.depth.data();
     // Per chunk: drawable primitives and the range of their keys (8 bytes read per primitive).
-    std::vector<ChunkRange> range(chunks);
-    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    std::vector<ChunkRange> range(chunks.count);
+    tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
         ChunkRange& r = range[c];
-        for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) {
+        for (size_t i = chunks.begin(c); i < chunks.end(c); ++i) {
             const uint32_t o = orderOf[i];
             if (o == ProjectedWindow::kNotDrawn) continue;
             ++r.count;
@@ -219,8 +231,8 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
     });
     ChunkRange all;
     std::vector<size_t>& cursor = chunkCounts_;
-    cursor.assign(chunks, 0);
-    for (size_t c = 0; c < chunks; ++c) {
+    cursor.assign(chunks.count, 0);
+    for (size_t c = 0; c < chunks.count; ++c) {
         cursor[c] = all.count, all.count += range[c].count;
         all.orderLo = std::min(all.orderLo, range[c].orderLo), all.orderHi = std::max(all.orderHi, range[c].orderHi);
         all.depthLo = std::min(all.depthLo, range[c].depthLo), all.depthHi = std::max(all.depthHi, range[c].depthHi);
@@ -241,9 +253,9 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
     growDiscarding(order_, total), growDiscarding(sortScratch_, total);
     growDiscarding(ranges_, total);
     orderCount_ = total;
-    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
         size_t k = cursor[c];
-        for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i)
+        for (size_t i = chunks.begin(c); i < chunks.end(c); ++i)
             if (orderOf[i] != ProjectedWindow::kNotDrawn) order_[k++] = layout.key(orderOf[i], depthOf[i]) << indexBits_ | i;
     });
     // order_ is in index order; the stable sort by key makes it the total (key, index) order.
@@ -260,10 +272,10 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
 /// records, the exact-index maps and the slab profiles into sorted copies cost more than it saved).
 SkippedPrimitives TileCompositor::binToTiles() {
     const size_t tiles = size_t(tilesX_) * tilesY_, n = orderCount_;
-    const size_t chunks = std::clamp<size_t>(n / 4096, 1, 64), per = (n + chunks - 1) / chunks;
+    const Chunks chunks(n);
     std::vector<uint32_t>& counts = binCounts_;  // reused: fresh pages cost a fault each on every window
-    counts.assign(chunks * tiles, 0);
-    std::vector<SkippedPrimitives> skippedIn(chunks);
+    counts.assign(chunks.count * tiles, 0);
+    std::vector<SkippedPrimitives> skippedIn(chunks.count);
     const auto forTiles = [&](const PixelRange& range, auto&& fn) {
         const int tx0 = range.x0 / kTileSize, tx1 = range.x1 / kTileSize;
         for (int ty = range.y0 / kTileSize; ty <= range.y1 / kTileSize; ++ty)
@@ -274,11 +286,11 @@ SkippedPrimitives TileCompositor::binToTiles() {
     };
     // Each primitive's range, in sorted order, and the tiles it counts in.
     const ProjectedWindow& window = *window_;
-    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
         uint32_t* count = counts.data() + c * tiles;
         SkippedPrimitives& skipped = skippedIn[c];
-        const size_t end = std::min(n, (c + 1) * per);
-        for (size_t k = c * per; k < end; ++k) {
+        const size_t end = chunks.end(c);
+        for (size_t k = chunks.begin(c); k < end; ++k) {
             if (k + 8 < end) __builtin_prefetch(&window.records[indexOf(order_[k + 8])]);  // a random line each
             const uint32_t i = indexOf(order_[k]);
             const TileRecord& p = window.records[i];
@@ -297,7 +309,7 @@ SkippedPrimitives TileCompositor::binToTiles() {
     size_t total = 0;
     for (size_t tile = 0; tile < tiles; ++tile) {
         binStart_[tile] = total;
-        for (size_t c = 0; c < chunks; ++c) {
+        for (size_t c = 0; c < chunks.count; ++c) {
             const uint32_t k = counts[c * tiles + tile];
             counts[c * tiles + tile] = uint32_t(total);
             total += k;
@@ -305,9 +317,9 @@ SkippedPrimitives TileCompositor::binToTiles() {
     }
     binStart_[tiles] = total;
     growDiscarding(binEntries_, total);
-    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
         uint32_t* cursor = counts.data() + c * tiles;
-        for (size_t k = c * per; k < std::min(n, (c + 1) * per); ++k)
+        for (size_t k = chunks.begin(c); k < chunks.end(c); ++k)
             forTiles(ranges_[k], [&](size_t tile) { binEntries_[cursor[tile]++] = indexOf(order_[k]); });
     });
     SkippedPrimitives skipped;

@@ -66,7 +66,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point ? INFINITY
                                  : drawsOnlySplats(settings.mode)   ? 0.0
                                                                     : pass.threshold;
-    ForwardBuffers own;  // empty vectors: nothing allocated unless the caller keeps none
+    ForwardBuffers own;  // used only when the caller keeps none (empty until then: no allocation)
     ForwardBuffers& buffers = control.buffers ? *control.buffers : own;
     VoxelStream stream(volume, camera, table, streamOptions, shader, emission, &buffers.stream);
     ExactContext exact{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance};

@@ -251,21 +251,18 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                 PixelRange range;
                 if (laneContext && lanes.status[i - chunk] != SplatLanes::kScalar) {
                     kind = storeLaneSplat(lanes, i - chunk, i, batch, slab, ctx, window, range);
-                    if (ctx.slabs.on && kind != PrimitiveKind::Culled)
-                        window.profile[i] = slabProfileFor(glm::dvec3(batch.viewPos[i]), batch.distance[i], slab,
-                                                           batch.depthSpread.empty() ? 0.f : batch.depthSpread[i], ctx);
                 } else {
                     Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
                     p.members = batch.members[i];
                     p.depth = batch.distance[i];
                     p.slab = slab;
-                    if (ctx.slabs.on && p.kind != PrimitiveKind::Culled)
-                        p.profile = slabProfileFor(glm::dvec3(batch.viewPos[i]), batch.distance[i], p.slab,
-                                                   batch.depthSpread.empty() ? 0.f : batch.depthSpread[i], ctx);
-                    window.set(i, p);
+                    window.set(i, p);  // its profile below (set() writes p's default one first)
                     kind = p.kind, range = p.range;
                 }
                 if (kind == PrimitiveKind::Culled) continue;
+                if (ctx.slabs.on)
+                    window.profile[i] = slabProfileFor(glm::dvec3(batch.viewPos[i]), batch.distance[i], slab,
+                                                       batch.depthSpread.empty() ? 0.f : batch.depthSpread[i], ctx);
                 const uint32_t members = batch.members[i];
                 ++(kind == PrimitiveKind::Point ? c.points : c.splats);
                 if (kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;

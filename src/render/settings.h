@@ -167,10 +167,10 @@ struct RenderSettings {
     nlohmann::json toJson() const;
 };
 
-/// @brief How a long render reports progress and learns that it should stop (Ctrl-C).
-/// Both are optional and neither changes the image.
 struct ForwardBuffers;  // render/forward_buffers.h
 
+/// @brief How a long render reports progress, learns that it should stop (Ctrl-C), and which
+/// memory it may reuse. All are optional and none changes the image.
 struct RenderControl {
     /// The fraction of the work done, in [0, 1]; called from rendering threads (thread-safe, cheap).
     std::function<void(double)> progress;
