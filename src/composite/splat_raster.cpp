@@ -22,44 +22,45 @@ namespace hn = hwy::HWY_NAMESPACE;
 constexpr int kStride = kTileSize;  // tile row stride
 constexpr int kPairLanes = 16;  // DrawRowPairs: two rows of 8 pixels per vector (16-lane targets)
 
-/// The row's chord of the support ellipse i² < 1 (one pixel of slack each side; the mask decides).
-inline bool rowChord(const SplatRaster& s, float dy, int& xa, int& xb) {
-    const float b = s.qxy * dy, disc = b * b - s.qxx * (s.qyy * dy * dy - 1.f);
-    if (!(disc > 0.f)) return false;
-    const float root = std::sqrt(disc);
-    const float lo = s.cx - 0.5f + (-b - root) / s.qxx, hi = s.cx - 0.5f + (-b + root) / s.qxx;
-    xa = std::max(s.x0, int(std::floor(lo)));
-    xb = std::min(s.x1, int(std::ceil(hi)));
-    return xa <= xb;
+/// The exact d² = |w|² / |v|² / r², w = c × v, at pixel offsets (dx, dy) from the centre
+/// (DESIGN §3; ExactIndexMap::d2).
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V ExactT(D d, const SplatRaster& s, V dx, V dy) {
+    const auto affine = [&](const glm::vec3& base, const glm::vec3& perY, const glm::vec3& perX, int c) {
+        return hn::MulAdd(dx, hn::Set(d, perX[c]), hn::MulAdd(dy, hn::Set(d, perY[c]), hn::Set(d, base[c])));
+    };
+    const V wx = affine(s.map.A, s.map.C, s.map.B, 0), wy = affine(s.map.A, s.map.C, s.map.B, 1),
+            wz = affine(s.map.A, s.map.C, s.map.B, 2);
+    const V vx = affine(s.map.v0, s.map.vy, s.map.vx, 0), vy = affine(s.map.v0, s.map.vy, s.map.vx, 1),
+            vz = affine(s.map.v0, s.map.vy, s.map.vx, 2);
+    const V w2 = hn::MulAdd(wx, wx, hn::MulAdd(wy, wy, hn::Mul(wz, wz)));
+    const V v2 = hn::MulAdd(vx, vx, hn::MulAdd(vy, vy, hn::Mul(vz, vz)));
+    return hn::Mul(hn::Div(w2, v2), hn::Set(d, s.map.invR2));
 }
 
-/// τ of the splat at pixel offsets (dx, dy) from its centre, for the lanes of @p mask (which
-/// the exact index narrows to d² < 1): τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h).
-template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
-HWY_INLINE V Tau(D d, const SplatRaster& s, V dx, V dy, V i2, M& mask) {
+/// τ of the splat at index t (i², or the exact d²; the lanes of @p mask are those with t < 1):
+/// τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h).
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V TauAt(D d, const SplatRaster& s, V t) {
     const V zero = hn::Zero(d), one = hn::Set(d, 1.f), two = hn::Set(d, 2.f);
-    V t;
-    if (s.exactIndex) {  // d² = |w|² / |v|² / r², w = c × v (DESIGN §3; ExactIndexMap::d2)
-        const auto affine = [&](const glm::vec3& base, const glm::vec3& perY, const glm::vec3& perX, int c) {
-            return hn::MulAdd(dx, hn::Set(d, perX[c]), hn::MulAdd(dy, hn::Set(d, perY[c]), hn::Set(d, base[c])));
-        };
-        const V wx = affine(s.map.A, s.map.C, s.map.B, 0), wy = affine(s.map.A, s.map.C, s.map.B, 1),
-                wz = affine(s.map.A, s.map.C, s.map.B, 2);
-        const V vx = affine(s.map.v0, s.map.vy, s.map.vx, 0), vy = affine(s.map.v0, s.map.vy, s.map.vx, 1),
-                vz = affine(s.map.v0, s.map.vy, s.map.vx, 2);
-        const V w2 = hn::MulAdd(wx, wx, hn::MulAdd(wy, wy, hn::Mul(wz, wz)));
-        const V v2 = hn::MulAdd(vx, vx, hn::MulAdd(vy, vy, hn::Mul(vz, vz)));
-        t = hn::Mul(hn::Div(w2, v2), hn::Set(d, s.map.invR2));
-        mask = hn::And(mask, hn::Lt(t, one));
-    } else {
-        t = i2;
-    }
     t = hn::Min(hn::Max(t, zero), one);
     const V x = hn::MulSub(two, t, one);
     V p = hn::Set(d, s.coef[FootprintPolynomials::kDegree]);
 #pragma GCC unroll 16
     for (int j = FootprintPolynomials::kDegree - 1; j >= 0; --j) p = hn::MulAdd(p, x, hn::Set(d, s.coef[size_t(j)]));
     return hn::Max(hn::Mul(hn::Mul(hn::Set(d, s.scale), hn::Sqrt(hn::Sub(one, t))), p), zero);
+}
+
+/// τ of the splat at pixel offsets (dx, dy) from its centre, for the lanes of @p mask (which
+/// the exact index narrows to d² < 1).
+template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
+HWY_INLINE V Tau(D d, const SplatRaster& s, V dx, V dy, V i2, M& mask) {
+    V t = i2;
+    if (s.exactIndex) {
+        t = ExactT(d, s, dx, dy);
+        mask = hn::And(mask, hn::Lt(t, hn::Set(d, 1.f)));
+    }
+    return TauAt(d, s, t);
 }
 
 /// α = 1 − e^{−τ} for τ ≥ 0. A vector whose lanes all have τ < 1/2 takes the Taylor series to τ⁸
@@ -115,42 +116,109 @@ HWY_INLINE V IndexSquared(D d, const SplatRaster& s, V dx, V dy) {
                       hn::Mul(hn::MulAdd(hn::Set(d, 2.f * s.qxy), dx, hn::Mul(hn::Set(d, s.qyy), dy)), dy));
 }
 
+/// What DrawRowsWide needs of each of a splat's rows in a tile (index k: row y0 + k), set up a
+/// vector of rows at a time: the row's chord [xa, xb] in tile columns (xa > xb: none) and, with
+/// dx the pixel centre's x − cx, the row's quadratics in dx:
+///     i²  = i0 + dx·(i1 + Qxx·dx)                    (i0 = Qyy dy², i1 = 2 Qxy dy)
+///     |w|² = w0 + dx·(w1 + |B|²·dx), |v|² = v0 + dx·(v1 + |v_x|²·dx)   (exact index, row part
+///           W = A + C·dy: w0 = |W|², w1 = 2 W·B; likewise v from v0, v_y, v_x; DESIGN §3)
+/// so that a vector of pixels costs two FMAs per quadratic instead of the affine maps' eighteen.
+struct RowQuadratics {
+    static constexpr int kMax = kTileSize + 16;  ///< rows of a tile, and a last vector's spill
+    alignas(64) int32_t xa[kMax], xb[kMax];
+    alignas(64) float i0[kMax], i1[kMax];
+    alignas(64) float w0[kMax], w1[kMax], v0[kMax], v1[kMax];
+};
+
+/// Every row's chord of the support ellipse i² < 1, one reciprocal for its two roots (as
+/// DrawRowPairsIfNarrow: the chord keeps a pixel of slack each side and the mask i² < 1 decides every pixel) and quadratics.
+template <class D>
+HWY_INLINE void SetUpRows(D d, const SplatRaster& s, const TileBuffers& tile, RowQuadratics& q) {
+    using V = hn::Vec<D>;
+    const hn::RebindToSigned<D> di;
+    const int n = int(hn::Lanes(d)), rows = s.y1 - s.y0 + 1;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.f);
+    const V base = hn::Set(d, s.cx - 0.5f), invQxx = hn::Set(d, 1.f / s.qxx);
+    const V x0 = hn::Set(d, float(s.x0)), x1 = hn::Set(d, float(s.x1));
+    const auto tileX0 = hn::Set(di, tile.x0);
+    for (int k = 0; k < rows; k += n) {
+        const V dy = hn::Sub(hn::Iota(d, float(s.y0 + k) + 0.5f), hn::Set(d, s.cy));  // float(y) + 0.5 − cy
+        const V b = hn::Mul(hn::Set(d, s.qxy), dy);
+        const V disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, s.qxx), hn::Sub(hn::Mul(hn::Mul(hn::Set(d, s.qyy), dy), dy), one)));
+        const auto has = hn::Gt(disc, zero);
+        const V root = hn::Sqrt(hn::Max(disc, zero));
+        const V lo = hn::MulAdd(hn::Sub(hn::Neg(b), root), invQxx, base);
+        const V hi = hn::MulAdd(hn::Sub(root, b), invQxx, base);
+        const auto xa = hn::Sub(hn::ConvertTo(di, hn::Max(hn::Floor(lo), x0)), tileX0);
+        const auto xb = hn::Sub(hn::ConvertTo(di, hn::Min(hn::Ceil(hi), x1)), tileX0);
+        hn::StoreU(xa, di, q.xa + k);
+        hn::StoreU(hn::IfThenElse(hn::RebindMask(di, has), xb, hn::Sub(xa, hn::Set(di, 1))), di, q.xb + k);
+        hn::StoreU(hn::Mul(hn::Mul(hn::Set(d, s.qyy), dy), dy), d, q.i0 + k);
+        hn::StoreU(hn::Mul(hn::Set(d, 2.f * s.qxy), dy), d, q.i1 + k);
+        if (!s.exactIndex) continue;
+        const auto quadratic = [&](const glm::vec3& c0, const glm::vec3& perY, const glm::vec3& perX, float* q0, float* q1) {
+            V sq = zero, lin = zero;
+            for (int c = 0; c < 3; ++c) {
+                const V w = hn::MulAdd(dy, hn::Set(d, perY[c]), hn::Set(d, c0[c]));  // the row's W
+                sq = hn::MulAdd(w, w, sq);
+                lin = hn::MulAdd(w, hn::Set(d, 2.f * perX[c]), lin);
+            }
+            hn::StoreU(sq, d, q0 + k);
+            hn::StoreU(lin, d, q1 + k);
+        };
+        quadratic(s.map.A, s.map.C, s.map.B, q.w0, q.w1);
+        quadratic(s.map.v0, s.map.vy, s.map.vx, q.v0, q.v1);
+    }
+}
+
 /// One row, one vector per n pixels of its chord, the first starting at the chord's first pixel
 /// (a chord of up to n pixels is one vector wherever it lies; aligned starts took two for most
 /// chords of a close-up's splats). A vector that would run past the row's end is moved back
-/// inside it, and its lanes the previous vector drew are masked off.
+/// inside it, and its lanes the previous vector drew are masked off. The rows come prepared
+/// (SetUpRows): a vector costs its pixels' quadratics, the footprint and the deposit.
 template <bool kSlabs>
 void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
     const hn::CappedTag<float, kStride> d;
     const int n = int(hn::Lanes(d));
     using V = hn::Vec<decltype(d)>;
+    RowQuadratics q;
+    SetUpRows(d, s, tile, q);
     const V lane = hn::Iota(d, 0.5f);  // pixel centre offsets 0.5, 1.5, …
-    const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon);
+    const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon), qxx = hn::Set(d, s.qxx);
     const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
-    for (int y = s.y0; y <= s.y1; ++y) {
-        const float dyf = float(y) + 0.5f - s.cy;
-        int xa, xb;
-        if (!rowChord(s, dyf, xa, xb)) continue;
-        const V dy = hn::Set(d, dyf);
-        const V hi = hn::Set(d, float(xb) + 0.75f);
-        const int row = (y - tile.y0) * kStride;
-        for (int from = xa - tile.x0; from <= xb - tile.x0; from += n) {
+    const V wxx = hn::Set(d, glm::dot(s.map.B, s.map.B)), vxx = hn::Set(d, glm::dot(s.map.vx, s.map.vx));
+    const V invR2 = hn::Set(d, s.map.invR2);
+    const V cx = hn::Set(d, s.cx);
+    const int rows = s.y1 - s.y0 + 1;
+    for (int k = 0; k < rows; ++k) {
+        const int xa = q.xa[k], xb = q.xb[k];
+        if (xa > xb) continue;
+        const V i0 = hn::Set(d, q.i0[k]), i1 = hn::Set(d, q.i1[k]);
+        const int row = (s.y0 + k - tile.y0) * kStride;
+        for (int from = xa; from <= xb; from += n) {
             const int c = std::min(from, kStride - n);  // the vector's first pixel, inside the row
-            const V lo = hn::Set(d, float(tile.x0 + from));  // pixels from `from` on: not drawn yet
-            const V xPix = hn::Add(hn::Set(d, float(tile.x0 + c)), lane);  // pixel centres
-            const V dx = hn::Sub(xPix, hn::Set(d, s.cx));
-            const V i2 = IndexSquared(d, s, dx, dy);
+            // Lanes [from − c, xb − c]: the chord's pixels the previous vector has not drawn.
+            const auto chord = hn::AndNot(hn::FirstN(d, size_t(from - c)), hn::FirstN(d, size_t(std::min(xb - c + 1, n))));
+            const V dx = hn::Sub(hn::Add(hn::Set(d, float(tile.x0 + c)), lane), cx);  // pixel centre − cx
+            const V i2 = hn::MulAdd(hn::MulAdd(qxx, dx, i1), dx, i0);
             float* pt = tile.T + row + c;
             const V T = hn::LoadU(d, pt);
-            auto mask = hn::And(hn::And(hn::Ge(xPix, lo), hn::Lt(xPix, hi)), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
+            auto mask = hn::And(chord, hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
             if (hn::AllFalse(d, mask)) continue;
+            V t = i2;
+            if (s.exactIndex) {
+                const V w2 = hn::MulAdd(hn::MulAdd(wxx, dx, hn::Set(d, q.w1[k])), dx, hn::Set(d, q.w0[k]));
+                const V v2 = hn::MulAdd(hn::MulAdd(vxx, dx, hn::Set(d, q.v1[k])), dx, hn::Set(d, q.v0[k]));
+                t = hn::Mul(hn::Div(w2, v2), invR2);
+                mask = hn::And(mask, hn::Lt(t, one));
+            }
+            const V tau = TauAt(d, s, t);
             if constexpr (kSlabs) {
-                const V tau = Tau(d, s, dx, dy, i2, mask);
                 DepositSlabs(d, s, tau, mask, [&](float* base) { return hn::LoadU(d, base + row + c); },
                              [&](float* base, V v) { hn::StoreU(v, d, base + row + c); });
                 continue;
             }
-            const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
+            const V ta = hn::Mul(T, OpacityFromTau(d, tau));
             float *pr = tile.R + row + c, *pg = tile.G + row + c, *pb = tile.B + row + c;
             hn::StoreU(hn::IfThenElse(mask, hn::MulAdd(ta, cr, hn::LoadU(d, pr)), hn::LoadU(d, pr)), d, pr);
             hn::StoreU(hn::IfThenElse(mask, hn::MulAdd(ta, cg, hn::LoadU(d, pg)), hn::LoadU(d, pg)), d, pg);
@@ -219,7 +287,7 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
     }
 }
 
-/// Every row's chord at once (rowChord's arithmetic, one lane per row of the splat's rows in the
+/// Every row's chord at once (SetUpRows' arithmetic, one lane per row of the splat's rows in the
 /// tile), and from them, in the same lanes, each row's 8-pixel window and chord mask; if the rows
 /// with a chord are one run (they are: an ellipse is convex) and every chord fits its window,
 /// draws them two by two (DrawRowPairs) and returns true.
