@@ -287,6 +287,54 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
     }
 }
 
+/// A splat whose pixel box in the tile is at most 8 columns wide (most splats of a framed view):
+/// every row's 8-pixel window starts at the box's first column, so two rows share a vector as in
+/// DrawRowPairs with nothing set up per row: the mask i² < 1 alone picks the ellipse's pixels (the
+/// chord would only skip lanes it rejects). Per splat, dx and the i² terms in dx alone are fixed:
+/// i² = Qxx dx² + (2 Qxy dx + Qyy dy)·dy, two FMAs a vector.
+template <bool kSlabs, class D>
+void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
+    using V = hn::Vec<D>;
+    const hn::Half<D> dh;
+    constexpr int kHalf = kPairLanes / 2;
+    const int start = std::min(s.x0 - tile.x0, kStride - kHalf);  // the window's first column
+    const V xPix = hn::Add(hn::Set(d, float(tile.x0 + start)), hn::Combine(d, hn::Iota(dh, 0.5f), hn::Iota(dh, 0.5f)));
+    const V dx = hn::Sub(xPix, hn::Set(d, s.cx));
+    const V ixx = hn::Mul(hn::Mul(hn::Set(d, s.qxx), dx), dx), ixy = hn::Mul(hn::Set(d, 2.f * s.qxy), dx);
+    const V qyy = hn::Set(d, s.qyy), cy = hn::Set(d, s.cy);
+    const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon);
+    const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
+    // The box's columns, in each half; a lone last row keeps the lower half only.
+    const auto columns = hn::And(hn::Ge(xPix, hn::Set(d, float(s.x0))), hn::Lt(xPix, hn::Set(d, float(s.x1 + 1))));
+    const auto lowerHalf = hn::FirstN(d, size_t(kHalf));
+    V yPix = hn::Add(hn::Set(d, float(s.y0) + 0.5f), hn::Combine(d, hn::Set(dh, 1.f), hn::Zero(dh)));  // rows y, y + 1
+    const V two = hn::Set(d, 2.f);
+    for (int y = s.y0; y <= s.y1; y += 2, yPix = hn::Add(yPix, two)) {
+        const bool pair = y < s.y1;
+        const int offA = (y - tile.y0) * kStride + start, offB = pair ? offA + kStride : offA;
+        const V dy = hn::Sub(yPix, cy);  // float(y) + 0.5 − cy, as every loop computes it
+        const V i2 = hn::MulAdd(hn::MulAdd(qyy, dy, ixy), dy, ixx);
+        const auto load = [&](const float* base) { return hn::Combine(d, hn::LoadU(dh, base + offB), hn::LoadU(dh, base + offA)); };
+        const V T = load(tile.T);
+        auto mask = hn::And(pair ? columns : hn::And(columns, lowerHalf), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
+        if (hn::AllFalse(d, mask)) continue;
+        const auto store = [&](float* base, V value) {
+            hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
+            if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
+        };
+        if constexpr (kSlabs) {
+            DepositSlabs(d, s, Tau(d, s, dx, dy, i2, mask), mask, [&](float* base) { return load(base); }, store);
+            continue;
+        }
+        const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
+        const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
+        store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, cr, R), R));
+        store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, cg, G), G));
+        store(tile.B, hn::IfThenElse(mask, hn::MulAdd(ta, cb, B), B));
+        store(tile.T, hn::IfThenElse(mask, hn::Sub(T, ta), T));  // T·(1 − α)
+    }
+}
+
 /// Every row's chord at once (SetUpRows' arithmetic, one lane per row of the splat's rows in the
 /// tile), and from them, in the same lanes, each row's 8-pixel window and chord mask; if the rows
 /// with a chord are one run (they are: an ellipse is convex) and every chord fits its window,
@@ -345,6 +393,7 @@ void DrawSplatRowsFor(D d, const SplatRaster& s, const TileBuffers& tile) {
 #if HWY_TARGET != HWY_SCALAR
     // Splats up to 16 rows tall in the tile whose every chord fits 8 pixels: two rows a vector.
     if constexpr (hn::MaxLanes(D()) == kPairLanes) {
+        if (s.x1 - s.x0 < kPairLanes / 2) return DrawBoxPairs<kSlabs>(d, s, tile);
         if (s.y1 - s.y0 + 1 <= kPairLanes && DrawRowPairsIfNarrow<kSlabs>(d, s, tile)) return;
     }
 #else
