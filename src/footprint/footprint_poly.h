@@ -30,7 +30,8 @@ public:
     static constexpr double kAlphaMaxDeg = 15.0;    ///< beyond: the table path (closed-form reindex)
     static constexpr double kErrorBound = 1.0e-6;   ///< relative to F(0); measured ≈ 5e−7
 
-    using Coefficients = std::array<float, kCoefficients>;  ///< c_0 … c_10 in x = 2t − 1
+    static constexpr int kStorage = 12;              ///< kCoefficients and a zero: row()'s lerp vectorises
+    using Coefficients = std::array<float, kStorage>;  ///< c_0 … c_10 in x = 2t − 1, then 0
 
     /// @brief Fits every row from Kernel::footprint (deterministic, in memory, well under 1 ms).
     static FootprintPolynomials build(const KernelShape& kernel = KernelShape::standard());
@@ -44,7 +45,7 @@ public:
         const float w = float(pos - k);
         const Coefficients &a = rows_[size_t(k)], &b = rows_[size_t(k) + 1];
         Coefficients c;
-        for (int j = 0; j < kCoefficients; ++j) c[size_t(j)] = a[size_t(j)] + w * (b[size_t(j)] - a[size_t(j)]);
+        for (int j = 0; j < kStorage; ++j) c[size_t(j)] = a[size_t(j)] + w * (b[size_t(j)] - a[size_t(j)]);
         return c;
     }
     /// @brief The α = 0 row: F as a polynomial in d² (for the exact-index path).
