@@ -152,6 +152,12 @@ TileCompositor::TileCompositor(int width, int height, const Tables& tables, cons
         for (int tx = 0; tx < tilesX_; ++tx)
             liveCount_[size_t(ty) * tilesX_ + tx] = (std::min(width_, (tx + 1) * kTileSize) - tx * kTileSize) *
                                                     (std::min(height_, (ty + 1) * kTileSize) - ty * kTileSize);
+    liveRows_.resize(size_t(height_) * size_t(tilesX_));
+    for (int y = 0; y < height_; ++y)
+        for (int tx = 0; tx < tilesX_; ++tx) {
+            const int columns = std::min(width_, (tx + 1) * kTileSize) - tx * kTileSize;  // 1 … 32
+            liveRows_[size_t(y) * tilesX_ + tx] = ~uint32_t(0) >> (kTileSize - columns);
+        }
     slabs_.reach = std::clamp(slabs_.reach, 0, kMaxSlabReach);
     if (slabs_.on) rings_.resize(size_t(tilesX_) * tilesY_);
 }
@@ -387,6 +393,14 @@ void TileCompositor::storeTile(int tile, const TilePixels& px) {
             color_[k] = glm::vec3(px.R[i], px.G[i], px.B[i]);
         }
     liveCount_[size_t(tile)] = px.countLive();
+    // Each row's live pixels as bits (pixels past the image's edge hold T = 0: never live).
+    const size_t tx = size_t(tile % tilesX_);
+    for (int y = px.y0; y <= px.y1; ++y) {
+        const float* row = px.T.data() + size_t(y - px.y0) * kTileSize;
+        uint32_t bits = 0;
+        for (int j = 0; j < kTileSize; ++j) bits |= uint32_t(row[j] >= kTransmittanceEpsilon) << j;
+        liveRows_[size_t(y) * size_t(tilesX_) + tx] = bits;
+    }
 }
 
 namespace {

@@ -111,15 +111,15 @@ public:
     Image image() const;
 
 private:
-    /// Whether a pixel of tile (@p tx, @p ty) inside the inclusive rectangle has T ≥ ε.
+    /// Whether a pixel of tile (@p tx, @p ty) inside the inclusive rectangle has T ≥ ε: the
+    /// rectangle's columns of the tile as a bit mask against each of its rows' live bits.
     bool anyLive(int tx, int ty, int x0, int y0, int x1, int y1) const {
         const int ya = std::max(y0, ty * kTileSize), yb = std::min(y1, ty * kTileSize + kTileSize - 1);
-        const int xa = std::max(x0, tx * kTileSize), xb = std::min(x1, tx * kTileSize + kTileSize - 1);
-        for (int y = ya; y <= yb; ++y) {
-            const float* row = transmittance_.data() + size_t(y) * size_t(width_);
-            for (int x = xa; x <= xb; ++x)
-                if (row[x] >= kTransmittanceEpsilon) return true;
-        }
+        const int xa = std::max(x0, tx * kTileSize) - tx * kTileSize, xb = std::min(x1, tx * kTileSize + kTileSize - 1) - tx * kTileSize;
+        static_assert(kTileSize == 32, "a tile row's live pixels are one 32-bit word");
+        const uint32_t columns = (~uint32_t(0) >> (31 - (xb - xa))) << xa;  // bits xa … xb
+        for (int y = ya; y <= yb; ++y)
+            if (liveRows_[size_t(y) * size_t(tilesX_) + size_t(tx)] & columns) return true;
         return false;
     }
     /// A sort entry: the key (slab (relative) · kind · depth bits) above the primitive's index
@@ -160,6 +160,7 @@ private:
     Buffer<glm::vec3>& color_;            // premultiplied radiance (the first width·height)
     Buffer<float>& transmittance_;
     std::vector<int> liveCount_;          // per tile: pixels with T ≥ ε
+    std::vector<uint32_t> liveRows_;      // per image row and tile column: bit j, pixel j of the tile's row has T ≥ ε
     const ProjectedWindow* window_ = nullptr;  // the window being composited (composite()'s argument)
     ProjectedWindow packed_;              // composite(span<const Primitive>)'s window
     size_t orderCount_ = 0;               // the window's drawable primitives (the buffers grow only)
