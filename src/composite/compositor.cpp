@@ -354,11 +354,22 @@ struct TileCompositor::TilePixels {
     int local(int x, int y) const { return local(x, y, x0, y0); }
     bool live(int i) const { return T[size_t(i)] >= kTransmittanceEpsilon; }
     /// Pixels with T ≥ ε; those past the image's edge hold T = 0. One branch-free pass over
-    /// the whole array, which the compiler vectorises (it runs every 32 primitives).
+    /// the whole array, which the compiler vectorises (storeTile: once per tile and window).
     int countLive() const {
         int n = 0;
         for (size_t i = 0; i < T.size(); ++i) n += T[i] >= kTransmittanceEpsilon ? 1 : 0;
         return n;
+    }
+    /// Whether any pixel has T ≥ ε, 16 pixels at a time (a live tile answers in its first 16:
+    /// tile-level early termination asks every 32 primitives, and counting all 1 024 pixels each
+    /// time was 70 % of compositeTile's own samples on the framed Engine).
+    bool anyLive() const {
+        for (size_t i = 0; i < T.size(); i += 16) {
+            bool any = false;
+            for (size_t j = 0; j < 16; ++j) any |= T[i + j] >= kTransmittanceEpsilon;
+            if (any) return true;
+        }
+        return false;
     }
     TileBuffers buffers() { return {T.data(), R.data(), G.data(), B.data(), x0, y0}; }
     /// α = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α   (DESIGN §4)
@@ -472,7 +483,7 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
             slabOf = p.slab;
         }
         // Tile-level early termination, checked every 32 primitives.
-        if ((e & 31) == 31 && !slab.dirty && px.countLive() == 0) break;
+        if ((e & 31) == 31 && !slab.dirty && !px.anyLive()) break;
         drawPrimitive(p, i, px, &slab, nullptr);
     }
     compositeSlab(px, slab);
@@ -504,12 +515,12 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entr
         closeUpTo(slab - reach);
         // Tile-level early termination, checked every 32 primitives (open slabs of finished
         // pixels add at most ε·c; they are composited below all the same).
-        if ((e & 31) == 31 && px.countLive() == 0) break;
+        if ((e & 31) == 31 && !px.anyLive()) break;
         const SlabTargets targets = ring.targets(window_->profile[i], slab, reach);
         if (targets.count > 0) drawPrimitive(p, i, px, nullptr, &targets);
     }
     closeUpTo(closeBefore);
-    const bool opaque = px.countLive() == 0;
+    const bool opaque = !px.anyLive();
     if (opaque && ring.open()) closeUpTo(ring.last + 1);
     // The ring stays with its tile until finish() (its slots are empty again once composited, and
     // allocating, zeroing, 2K + 1 slabs anew for every window cost more than the tile's work),
