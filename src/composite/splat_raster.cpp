@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <type_traits>
 
 #include "composite/opacity.h"
 #include "composite/splat_raster.h"
@@ -307,24 +308,24 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
     // The box's columns, in each half; a lone last row keeps the lower half only.
     const auto columns = hn::And(hn::Ge(xPix, hn::Set(d, float(s.x0))), hn::Lt(xPix, hn::Set(d, float(s.x1 + 1))));
     const auto lowerHalf = hn::FirstN(d, size_t(kHalf));
-    V yPix = hn::Add(hn::Set(d, float(s.y0) + 0.5f), hn::Combine(d, hn::Set(dh, 1.f), hn::Zero(dh)));  // rows y, y + 1
-    const V two = hn::Set(d, 2.f);
-    for (int y = s.y0; y <= s.y1; y += 2, yPix = hn::Add(yPix, two)) {
-        const bool pair = y < s.y1;
-        const int offA = (y - tile.y0) * kStride + start, offB = pair ? offA + kStride : offA;
+    // Rows y and y + 1 (offsets off and off + stride in the tile), or a lone last row: its upper
+    // half repeats it, masked off, and only the lower half is stored.
+    const auto rows = [&](auto pairTag, V yPix, int off) {
+        constexpr bool kPair = decltype(pairTag)::value;
+        const int offB = kPair ? off + kStride : off;
         const V dy = hn::Sub(yPix, cy);  // float(y) + 0.5 − cy, as every loop computes it
         const V i2 = hn::MulAdd(hn::MulAdd(qyy, dy, ixy), dy, ixx);
-        const auto load = [&](const float* base) { return hn::Combine(d, hn::LoadU(dh, base + offB), hn::LoadU(dh, base + offA)); };
+        const auto load = [&](const float* base) { return hn::Combine(d, hn::LoadU(dh, base + offB), hn::LoadU(dh, base + off)); };
         const V T = load(tile.T);
-        auto mask = hn::And(pair ? columns : hn::And(columns, lowerHalf), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
-        if (hn::AllFalse(d, mask)) continue;
+        auto mask = hn::And(kPair ? columns : hn::And(columns, lowerHalf), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
+        if (hn::AllFalse(d, mask)) return;
         const auto store = [&](float* base, V value) {
-            hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
-            if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
+            hn::StoreU(hn::LowerHalf(dh, value), dh, base + off);
+            if constexpr (kPair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
         if constexpr (kSlabs) {
             DepositSlabs(d, s, Tau(d, s, dx, dy, i2, mask), mask, [&](float* base) { return load(base); }, store);
-            continue;
+            return;
         }
         const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
         const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
@@ -332,7 +333,12 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
         store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, cg, G), G));
         store(tile.B, hn::IfThenElse(mask, hn::MulAdd(ta, cb, B), B));
         store(tile.T, hn::IfThenElse(mask, hn::Sub(T, ta), T));  // T·(1 − α)
-    }
+    };
+    V yPix = hn::Add(hn::Set(d, float(s.y0) + 0.5f), hn::Combine(d, hn::Set(dh, 1.f), hn::Zero(dh)));  // rows y, y + 1
+    const V two = hn::Set(d, 2.f);
+    int y = s.y0, off = (s.y0 - tile.y0) * kStride + start;
+    for (; y < s.y1; y += 2, off += 2 * kStride, yPix = hn::Add(yPix, two)) rows(std::true_type(), yPix, off);
+    if (y == s.y1) rows(std::false_type(), yPix, off);
 }
 
 /// Every row's chord at once (SetUpRows' arithmetic, one lane per row of the splat's rows in the
