@@ -132,7 +132,10 @@ struct RowQuadratics {
 };
 
 /// Every row's chord of the support ellipse i² < 1, one reciprocal for its two roots (as
-/// DrawRowPairsIfNarrow: the chord keeps a pixel of slack each side and the mask i² < 1 decides every pixel) and quadratics.
+/// DrawRowPairsIfNarrow: the chord keeps a pixel of slack each side and the mask i² < 1 decides
+/// every pixel), and its quadratics. The chord is clamped as integers to [x0, x1 + 1] and
+/// [x0 − 1, x1], so that no conic (a NaN or an infinity converted to an integer included) can
+/// send the row loop outside the tile.
 template <class D>
 HWY_INLINE void SetUpRows(D d, const SplatRaster& s, const TileBuffers& tile, RowQuadratics& q) {
     using V = hn::Vec<D>;
@@ -140,7 +143,7 @@ HWY_INLINE void SetUpRows(D d, const SplatRaster& s, const TileBuffers& tile, Ro
     const int n = int(hn::Lanes(d)), rows = s.y1 - s.y0 + 1;
     const V zero = hn::Zero(d), one = hn::Set(d, 1.f);
     const V base = hn::Set(d, s.cx - 0.5f), invQxx = hn::Set(d, 1.f / s.qxx);
-    const V x0 = hn::Set(d, float(s.x0)), x1 = hn::Set(d, float(s.x1));
+    const auto x0 = hn::Set(di, s.x0), x1 = hn::Set(di, s.x1), oneI = hn::Set(di, 1);
     const auto tileX0 = hn::Set(di, tile.x0);
     for (int k = 0; k < rows; k += n) {
         const V dy = hn::Sub(hn::Iota(d, float(s.y0 + k) + 0.5f), hn::Set(d, s.cy));  // float(y) + 0.5 − cy
@@ -150,10 +153,10 @@ HWY_INLINE void SetUpRows(D d, const SplatRaster& s, const TileBuffers& tile, Ro
         const V root = hn::Sqrt(hn::Max(disc, zero));
         const V lo = hn::MulAdd(hn::Sub(hn::Neg(b), root), invQxx, base);
         const V hi = hn::MulAdd(hn::Sub(root, b), invQxx, base);
-        const auto xa = hn::Sub(hn::ConvertTo(di, hn::Max(hn::Floor(lo), x0)), tileX0);
-        const auto xb = hn::Sub(hn::ConvertTo(di, hn::Min(hn::Ceil(hi), x1)), tileX0);
+        const auto xa = hn::Sub(hn::Min(hn::Max(hn::ConvertTo(di, hn::Floor(lo)), x0), hn::Add(x1, oneI)), tileX0);
+        const auto xb = hn::Sub(hn::Max(hn::Min(hn::ConvertTo(di, hn::Ceil(hi)), x1), hn::Sub(x0, oneI)), tileX0);
         hn::StoreU(xa, di, q.xa + k);
-        hn::StoreU(hn::IfThenElse(hn::RebindMask(di, has), xb, hn::Sub(xa, hn::Set(di, 1))), di, q.xb + k);
+        hn::StoreU(hn::IfThenElse(hn::RebindMask(di, has), xb, hn::Sub(xa, oneI)), di, q.xb + k);
         hn::StoreU(hn::Mul(hn::Mul(hn::Set(d, s.qyy), dy), dy), d, q.i0 + k);
         hn::StoreU(hn::Mul(hn::Set(d, 2.f * s.qxy), dy), d, q.i1 + k);
         if (!s.exactIndex) continue;
