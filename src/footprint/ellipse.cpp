@@ -42,9 +42,12 @@ void fillEllipse(SphereProjection& s) {
     const double z = s.c.z, r2 = s.r * s.r;
     const double rhoXY = s.rho;                      // D·sinθ
     const double q = z * z - r2;                     // D²·den
-    s.u = rhoXY > 0.0 ? glm::dvec2(s.c.x, -s.c.y) / rhoXY : glm::dvec2(1.0, 0.0);  // y flip
-    s.centre = s.principal + s.u * (s.f * rhoXY * z / q);
-    s.a = s.f * s.r * std::sqrt(s.D * s.D - r2) / q;
+    // Reciprocals once (1/ρ, 1/q), products after: the lane projection (render/project_vector.cpp)
+    // mirrors these operations, and its double divisions were what bounded it.
+    const double invRho = rhoXY > 0.0 ? 1.0 / rhoXY : 0.0, invQ = 1.0 / q;
+    s.u = rhoXY > 0.0 ? glm::dvec2(s.c.x * invRho, -s.c.y * invRho) : glm::dvec2(1.0, 0.0);  // y flip
+    s.centre = s.principal + s.u * (s.f * rhoXY * z * invQ);
+    s.a = s.f * s.r * std::sqrt(s.D * s.D - r2) * invQ;
     s.b = s.f * s.r / std::sqrt(q);
     const glm::dvec2 v(-s.u.y, s.u.x);
     const glm::dvec2 half(std::sqrt(s.a * s.a * s.u.x * s.u.x + s.b * s.b * v.x * v.x),
@@ -109,7 +112,7 @@ double SphereProjection::theta() const { return D > 0.0 ? std::atan2(rho, c.z) :
 double SphereProjection::affineIndexError() const {
     if (kind != SphereClass::Ellipse) return std::numeric_limits<double>::infinity();
     // tanθ·tanα with tanθ = ρ/z and tanα = r/√(D² − r²) (an Ellipse has z > r > 0 and D > r).
-    return (rho / c.z) * (r / std::sqrt((D - r) * (D + r)));
+    return (rho * r) / (c.z * std::sqrt((D - r) * (D + r)));
 }
 
 glm::dvec3 pixelRay(const SphereProjection& s, const PixelCoord& p) {

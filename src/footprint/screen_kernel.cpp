@@ -30,10 +30,11 @@ ScreenKernel makeScreenKernel(const SphereProjection& e, double prefilterVarianc
     k.aGeom = e.a, k.bGeom = e.b;
     k.a = std::sqrt(e.a * e.a + widen);
     k.b = std::sqrt(e.b * e.b + widen);
-    k.conic = inFrame(e.u, 1.0 / (k.a * k.a), 1.0 / (k.b * k.b));
-    k.amplitude = (e.a / k.a) * (e.b / k.b);  // √(det V / det V')
+    const double invA = 1.0 / k.a, invB = 1.0 / k.b;  // (mirrored by the lane projection)
+    k.conic = inFrame(e.u, invA * invA, invB * invB);
+    k.amplitude = (e.a * invA) * (e.b * invB);  // √(det V / det V')
     k.sinAlpha = e.sinAlpha;
-    k.pullback = inFrame(e.u, e.a / k.a, e.b / k.b);
+    k.pullback = inFrame(e.u, e.a * invA, e.b * invB);
     const glm::dvec2 v(-e.u.y, e.u.x);
     const glm::dvec2 half(std::sqrt(k.a * k.a * e.u.x * e.u.x + k.b * k.b * v.x * v.x),
                           std::sqrt(k.a * k.a * e.u.y * e.u.y + k.b * k.b * v.y * v.y));
@@ -61,9 +62,12 @@ double exactIndexD2(const ScreenKernel& k, const SphereProjection& e, const Pixe
 ExactIndexMap makeExactIndexMap(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& origin) {
     // p' = k.centre + S·(p − k.centre) = [k.centre + S·(origin − k.centre)] + S·δ, and
     // pixelRay(p') = ((p'.x − pp.x)/f, −(p'.y − pp.y)/f, 1) is affine in p'.
-    const glm::dvec3 v0 = pixelRay(e, k.centre + k.pullback * (origin - k.centre));
-    const glm::dvec3 vx(k.pullback[0].x / e.f, -k.pullback[0].y / e.f, 0.0);  // S·(1, 0) = column 0
-    const glm::dvec3 vy(k.pullback[1].x / e.f, -k.pullback[1].y / e.f, 0.0);
+    // (pixelRay with 1/f once: the lane projection mirrors these operations.)
+    const double invF = 1.0 / e.f;
+    const glm::dvec2 p0 = k.centre + k.pullback * (origin - k.centre);
+    const glm::dvec3 v0((p0.x - e.principal.x) * invF, -(p0.y - e.principal.y) * invF, 1.0);
+    const glm::dvec3 vx(k.pullback[0].x * invF, -k.pullback[0].y * invF, 0.0);  // S·(1, 0) = column 0
+    const glm::dvec3 vy(k.pullback[1].x * invF, -k.pullback[1].y * invF, 0.0);
     ExactIndexMap m;
     m.v0 = glm::vec3(v0), m.vx = glm::vec3(vx), m.vy = glm::vec3(vy);
     m.A = glm::vec3(glm::cross(e.c, v0)), m.B = glm::vec3(glm::cross(e.c, vx)), m.C = glm::vec3(glm::cross(e.c, vy));

@@ -25,7 +25,7 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
     const V widen = hn::Set(d, ctx.widen), hf = hn::Set(d, ctx.spacingTimesFocal), threshold = hn::Set(d, ctx.threshold);
     const V minDen = hn::Set(d, 1e-12), exactBound = hn::Set(d, ctx.exactIndexError);
     const V width = hn::Set(d, double(ctx.width)), height = hn::Set(d, double(ctx.height));
-    const V invR2 = hn::Set(d, 1.0 / (ctx.radius * ctx.radius));
+    const V invR2 = hn::Set(d, 1.0 / (ctx.radius * ctx.radius)), invF = hn::Set(d, 1.0 / ctx.focal);
     for (size_t i = 0; i < n; i += N) {
         const V x = hn::Load(d, L.x + i), y = hn::Load(d, L.y + i), z = hn::Load(d, L.z + i);
         // projectVoxel: in hybrid a point where h·f/z < threshold (z > 0 here).
@@ -44,26 +44,28 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         const V den = hn::Div(q, hn::Mul(D, D));
         handled = hn::And(handled, hn::And(hn::Gt(D, r), hn::And(hn::Gt(z, r), hn::Not(hn::Lt(den, minDen)))));
         const V sinAlpha = hn::Div(r, D);
-        // fillEllipse: u = (x, −y)/ρ ((1, 0) on the axis); centre = principal + u·(f·ρ·z/q);
-        // a = f·r·√(D² − r²)/q, b = f·r/√q.
+        // fillEllipse: u = (x, −y)·(1/ρ) ((1, 0) on the axis); centre = principal + u·(f·ρ·z·(1/q));
+        // a = f·r·√(D² − r²)·(1/q), b = f·r/√q.
         const auto onAxis = hn::Not(hn::Gt(rho, zero));
-        const V ux = hn::IfThenElse(onAxis, one, hn::Div(x, rho));
-        const V uy = hn::IfThenElse(onAxis, zero, hn::Div(hn::Neg(y), rho));
-        const V s = hn::Div(hn::Mul(hn::Mul(f, rho), z), q);
+        const V invRho = hn::Div(one, rho), invQ = hn::Div(one, q);
+        const V ux = hn::IfThenElse(onAxis, one, hn::Mul(x, invRho));
+        const V uy = hn::IfThenElse(onAxis, zero, hn::Mul(hn::Neg(y), invRho));
+        const V s = hn::Mul(hn::Mul(hn::Mul(f, rho), z), invQ);
         const V cx = hn::Add(px, hn::Mul(ux, s)), cy = hn::Add(py, hn::Mul(uy, s));
-        const V a = hn::Div(hn::Mul(fr, hn::Sqrt(hn::Sub(hn::Mul(D, D), r2))), q);
+        const V a = hn::Mul(hn::Mul(fr, hn::Sqrt(hn::Sub(hn::Mul(D, D), r2))), invQ);
         const V b = hn::Div(fr, hn::Sqrt(q));
-        // makeScreenKernel: a' = √(a² + w), b' = √(b² + w); conic = inFrame(u, 1/a'², 1/b'²),
-        // pullback = inFrame(u, a/a', b/b') with inFrame(u, X, Y) = X·u uᵀ + Y·v vᵀ, v = (−u.y, u.x).
+        // makeScreenKernel: a' = √(a² + w), b' = √(b² + w); conic = inFrame(u, (1/a')², (1/b')²),
+        // pullback = inFrame(u, a·(1/a'), b·(1/b')) with inFrame(u, X, Y) = X·u uᵀ + Y·v vᵀ, v = (−u.y, u.x).
         const V aw = hn::Sqrt(hn::Add(hn::Mul(a, a), widen)), bw = hn::Sqrt(hn::Add(hn::Mul(b, b), widen));
         const V uxux = hn::Mul(ux, ux), uyuy = hn::Mul(uy, uy), uyux = hn::Mul(uy, ux);
         const V vx = hn::Neg(uy), vy = ux;
         const V vxvx = hn::Mul(vx, vx), vyvx = hn::Mul(vy, vx), vyvy = hn::Mul(vy, vy);
-        const V X = hn::Div(one, hn::Mul(aw, aw)), Y = hn::Div(one, hn::Mul(bw, bw));
+        const V invAw = hn::Div(one, aw), invBw = hn::Div(one, bw);
+        const V X = hn::Mul(invAw, invAw), Y = hn::Mul(invBw, invBw);
         const V qxx = hn::Add(hn::Mul(X, uxux), hn::Mul(Y, vxvx));
         const V qxy = hn::Add(hn::Mul(X, uyux), hn::Mul(Y, vyvx));
         const V qyy = hn::Add(hn::Mul(X, uyuy), hn::Mul(Y, vyvy));
-        const V ra = hn::Div(a, aw), rb = hn::Div(b, bw);
+        const V ra = hn::Mul(a, invAw), rb = hn::Mul(b, invBw);
         const V amplitude = hn::Mul(ra, rb);
         const V p00 = hn::Add(hn::Mul(ra, uxux), hn::Mul(rb, vxvx));
         const V p01 = hn::Add(hn::Mul(ra, uyux), hn::Mul(rb, vyvx));  // = p10
@@ -87,8 +89,8 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         const V x0 = first(hn::Sub(cx, hx), width), y0 = first(hn::Sub(cy, hy), height);
         const V x1 = last(hn::Add(cx, hx), width), y1 = last(hn::Add(cy, hy), height);
         const auto onImage = hn::And(hn::Ge(x1, x0), hn::Ge(y1, y0));  // else makeSplat culls it (no pixel)
-        // affineIndexError: (ρ/z)·(r/√((D − r)(D + r))).
-        const V error = hn::Mul(hn::Div(rho, z), hn::Div(r, hn::Sqrt(hn::Mul(hn::Sub(D, r), hn::Add(D, r)))));
+        // affineIndexError: (ρ·r)/(z·√((D − r)(D + r))).
+        const V error = hn::Div(hn::Mul(rho, r), hn::Mul(z, hn::Sqrt(hn::Mul(hn::Sub(D, r), hn::Add(D, r)))));
         const auto exact = hn::And(hn::Gt(error, exactBound), hn::FirstN(d, ctx.autoExactIndex ? N : 0));
         hn::Store(amplitude, d, L.amplitude + i);
         hn::Store(cx, d, L.centreX + i), hn::Store(cy, d, L.centreY + i);
@@ -102,13 +104,13 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         hn::Store(status, d, st);
         for (size_t k = 0; k < N && i + k < n; ++k) L.status[i + k] = uint8_t(st[k]);
         if (hn::AllFalse(d, hn::And(handled, exact))) continue;
-        // makeExactIndexMap from the kernel's centre (makeSplat): p' = centre, v0 = ((cx − px)/f,
-        // −(cy − py)/f, 1), vx = (P00/f, −P01/f, 0), vy = (P10/f, −P11/f, 0); A = c × v0,
-        // B = c × vx, C = c × vy (glm::cross).
+        // makeExactIndexMap from the kernel's centre (makeSplat): p' = centre, v0 = ((cx − px)·(1/f),
+        // −(cy − py)·(1/f), 1), vx = (P00·(1/f), −P01·(1/f), 0), vy = (P10·(1/f), −P11·(1/f), 0);
+        // A = c × v0, B = c × vx, C = c × vy (glm::cross).
         const V pxp = cx, pyp = cy;
-        const V v0x = hn::Div(hn::Sub(pxp, px), f), v0y = hn::Div(hn::Neg(hn::Sub(pyp, py)), f), v0z = one;
-        const V vxx = hn::Div(p00, f), vxy = hn::Div(hn::Neg(p01), f), vxz = zero;
-        const V vyx = hn::Div(p01, f), vyy = hn::Div(hn::Neg(p11), f), vyz = zero;
+        const V v0x = hn::Mul(hn::Sub(pxp, px), invF), v0y = hn::Mul(hn::Neg(hn::Sub(pyp, py)), invF), v0z = one;
+        const V vxx = hn::Mul(p00, invF), vxy = hn::Mul(hn::Neg(p01), invF), vxz = zero;
+        const V vyx = hn::Mul(p01, invF), vyy = hn::Mul(hn::Neg(p11), invF), vyz = zero;
         const auto cross = [&](V wx, V wy, V wz, V out[3]) {
             out[0] = hn::Sub(hn::Mul(y, wz), hn::Mul(wy, z));
             out[1] = hn::Sub(hn::Mul(z, wx), hn::Mul(wz, x));
