@@ -163,7 +163,11 @@ PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const 
     q.color = ctx.showPrimitives ? splatTint(batch.color[i]) : batch.color[i];
     q.range = range = lanes.range(k);
     window.place(i, slab, batch.distance[i], batch.members[i]);
-    if (kind == PrimitiveKind::SplatExactIndex) window.extra[i] = PrimitiveExtra{lanes.exactMap(k), batch.viewPos[i], batch.sigma[i]};
+    if (kind == PrimitiveKind::SplatExactIndex) {  // in place (SplatLanes::exactMapInto)
+        PrimitiveExtra& extra = window.extra[i];
+        lanes.exactMapInto(k, extra.exactMap);
+        extra.viewPos = batch.viewPos[i], extra.sigma = batch.sigma[i];
+    }
     return kind;
 }
 

@@ -137,13 +137,11 @@ void projectSplatsVector(SplatLanes& lanes, size_t n, const SplatLaneContext& ct
     HWY_DYNAMIC_DISPATCH(ProjectSplats)(lanes, n, ctx);
 }
 
-ExactIndexMap SplatLanes::exactMap(size_t i) const {
+void SplatLanes::exactMapInto(size_t i, ExactIndexMap& m) const {
     const auto v3 = [&](int k) { return glm::vec3(float(map[k][i]), float(map[k + 1][i]), float(map[k + 2][i])); };
-    ExactIndexMap m;
     m.v0 = v3(0), m.vx = v3(3), m.vy = v3(6);
     m.A = v3(9), m.B = v3(12), m.C = v3(15);
     m.invR2 = float(map[18][i]);
-    return m;
 }
 
 }  // namespace vdbsplat

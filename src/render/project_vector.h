@@ -52,7 +52,15 @@ struct SplatLanes {
     uint8_t status[kSplatLanes];
 
     PixelRange range(size_t i) const { return {int(x0[i]), int(y0[i]), int(x1[i]), int(y1[i])}; }
-    ExactIndexMap exactMap(size_t i) const;
+    /// Lane @p i's map written into @p m field by field (the projection writes it straight into
+    /// the window: a map returned through the stack and copied stalled on store forwarding, a
+    /// quarter of the projection lambda's samples on the framed checker box).
+    void exactMapInto(size_t i, ExactIndexMap& m) const;
+    ExactIndexMap exactMap(size_t i) const {
+        ExactIndexMap m;
+        exactMapInto(i, m);
+        return m;
+    }
 };
 
 /// @brief Projects lanes [0, @p n) of @p lanes (n ≤ kSplatLanes; x, y, z set), writing their
