@@ -86,12 +86,6 @@ HWY_INLINE V OpacityFromTau(D d, V tau) {
     return hn::Neg(hn::Expm1(d, hn::Neg(tau)));  // 1 − e^{−τ}
 }
 
-/// T·α of the splat (Tau), α = 1 − e^{−τ}.
-template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
-HWY_INLINE V OpacityTimesT(D d, const SplatRaster& s, V dx, V dy, V i2, V T, M& mask) {
-    return hn::Mul(T, OpacityFromTau(d, Tau(d, s, dx, dy, i2, mask)));
-}
-
 /// --compositing slabs: τ·fraction_j and τ·fraction_j·c added to slab j's sums at the lanes of
 /// @p mask; @p load and @p store read and write one vector of a tile array at the lanes' pixels.
 template <class D, class V, class M, class Load, class Store>
@@ -107,6 +101,27 @@ HWY_INLINE void DepositSlabs(D d, const SplatRaster& s, V tau, M mask, const Loa
         store(pr, hn::MulAdd(tj, cr, load(pr)));
         store(pg, hn::MulAdd(tj, cg, load(pg)));
         store(pb, hn::MulAdd(tj, cb, load(pb)));
+    }
+}
+
+/// The splat's τ at the lanes of @p mask deposited into the tile, every loop's last step: into the
+/// slab sums (DepositSlabs), or "over": α = 1 − e^{−τ}, C += T·α·c, T −= T·α (DESIGN §4), with @p T
+/// the lanes' transmittance already loaded and @p rgb the splat's colour broadcast (by the caller,
+/// before its loop: read from the SplatRaster after the tile's stores it would be loaded again per
+/// vector, as the stores may alias it). @p load and @p store read and write one vector of a tile
+/// array at the lanes' pixels (one row's, or two rows' halves).
+template <bool kSlabs, class D, class V, class M, class Load, class Store>
+HWY_INLINE void Deposit(D d, const SplatRaster& s, const TileBuffers& tile, V tau, V T, M mask, const V (&rgb)[3],
+                        const Load& load, const Store& store) {
+    if constexpr (kSlabs) {
+        DepositSlabs(d, s, tau, mask, load, store);
+    } else {
+        const V ta = hn::Mul(T, OpacityFromTau(d, tau));  // T·α
+        const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
+        store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[0], R), R));
+        store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[1], G), G));
+        store(tile.B, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[2], B), B));
+        store(tile.T, hn::IfThenElse(mask, hn::Sub(T, ta), T));  // T·(1 − α)
     }
 }
 
@@ -189,10 +204,10 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
     SetUpRows(d, s, tile, q);
     const V lane = hn::Iota(d, 0.5f);  // pixel centre offsets 0.5, 1.5, …
     const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon), qxx = hn::Set(d, s.qxx);
-    const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
     const V wxx = hn::Set(d, glm::dot(s.map.B, s.map.B)), vxx = hn::Set(d, glm::dot(s.map.vx, s.map.vx));
     const V invR2 = hn::Set(d, s.map.invR2);
     const V cx = hn::Set(d, s.cx);
+    const V rgb[3] = {hn::Set(d, s.color.x), hn::Set(d, s.color.y), hn::Set(d, s.color.z)};
     const int rows = s.y1 - s.y0 + 1;
     for (int k = 0; k < rows; ++k) {
         const int xa = q.xa[k], xb = q.xb[k];
@@ -216,18 +231,8 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
                 t = hn::Mul(hn::Div(w2, v2), invR2);
                 mask = hn::And(mask, hn::Lt(t, one));
             }
-            const V tau = TauAt(d, s, t);
-            if constexpr (kSlabs) {
-                DepositSlabs(d, s, tau, mask, [&](float* base) { return hn::LoadU(d, base + row + c); },
-                             [&](float* base, V v) { hn::StoreU(v, d, base + row + c); });
-                continue;
-            }
-            const V ta = hn::Mul(T, OpacityFromTau(d, tau));
-            float *pr = tile.R + row + c, *pg = tile.G + row + c, *pb = tile.B + row + c;
-            hn::StoreU(hn::IfThenElse(mask, hn::MulAdd(ta, cr, hn::LoadU(d, pr)), hn::LoadU(d, pr)), d, pr);
-            hn::StoreU(hn::IfThenElse(mask, hn::MulAdd(ta, cg, hn::LoadU(d, pg)), hn::LoadU(d, pg)), d, pg);
-            hn::StoreU(hn::IfThenElse(mask, hn::MulAdd(ta, cb, hn::LoadU(d, pb)), hn::LoadU(d, pb)), d, pb);
-            hn::StoreU(hn::IfThenElse(mask, hn::Sub(T, ta), T), d, pt);  // T·(1 − α)
+            Deposit<kSlabs>(d, s, tile, TauAt(d, s, t), T, mask, rgb, [&](const float* base) { return hn::LoadU(d, base + row + c); },
+                            [&](float* base, V v) { hn::StoreU(v, d, base + row + c); });
         }
     }
 }
@@ -258,7 +263,7 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
     const hn::Half<D> dh;
     const V lanes = hn::Combine(d, hn::Iota(dh, 0.5f), hn::Iota(dh, 0.5f));  // pixel centre offsets, per half
     const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon), cx = hn::Set(d, s.cx);
-    const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
+    const V rgb[3] = {hn::Set(d, s.color.x), hn::Set(d, s.color.y), hn::Set(d, s.color.z)};
     const int end = w.first + w.count;
     for (int k = w.first; k < end; k += 2) {
         const bool pair = k + 1 < end;
@@ -278,16 +283,8 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
             hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
             if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
-        if constexpr (kSlabs) {
-            DepositSlabs(d, s, Tau(d, s, dx, dy, i2, mask), mask, [&](float* base) { return load(base); }, store);
-            continue;
-        }
-        const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
-        const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
-        store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, cr, R), R));
-        store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, cg, G), G));
-        store(tile.B, hn::IfThenElse(mask, hn::MulAdd(ta, cb, B), B));
-        store(tile.T, hn::IfThenElse(mask, hn::Sub(T, ta), T));  // T·(1 − α)
+        const V tau = Tau(d, s, dx, dy, i2, mask);  // narrows the mask (exact index) before the deposit reads it
+        Deposit<kSlabs>(d, s, tile, tau, T, mask, rgb, load, store);
     }
 }
 
@@ -307,7 +304,7 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
     const V ixx = hn::Mul(hn::Mul(hn::Set(d, s.qxx), dx), dx), ixy = hn::Mul(hn::Set(d, 2.f * s.qxy), dx);
     const V qyy = hn::Set(d, s.qyy), cy = hn::Set(d, s.cy);
     const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon);
-    const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
+    const V rgb[3] = {hn::Set(d, s.color.x), hn::Set(d, s.color.y), hn::Set(d, s.color.z)};
     // The box's columns, in each half; a lone last row keeps the lower half only.
     const auto columns = hn::And(hn::Ge(xPix, hn::Set(d, float(s.x0))), hn::Lt(xPix, hn::Set(d, float(s.x1 + 1))));
     const auto lowerHalf = hn::FirstN(d, size_t(kHalf));
@@ -326,16 +323,8 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
             hn::StoreU(hn::LowerHalf(dh, value), dh, base + off);
             if constexpr (kPair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
-        if constexpr (kSlabs) {
-            DepositSlabs(d, s, Tau(d, s, dx, dy, i2, mask), mask, [&](float* base) { return load(base); }, store);
-            return;
-        }
-        const V ta = OpacityTimesT(d, s, dx, dy, i2, T, mask);
-        const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
-        store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, cr, R), R));
-        store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, cg, G), G));
-        store(tile.B, hn::IfThenElse(mask, hn::MulAdd(ta, cb, B), B));
-        store(tile.T, hn::IfThenElse(mask, hn::Sub(T, ta), T));  // T·(1 − α)
+        const V tau = Tau(d, s, dx, dy, i2, mask);  // narrows the mask (exact index) before the deposit reads it
+        Deposit<kSlabs>(d, s, tile, tau, T, mask, rgb, load, store);
     };
     V yPix = hn::Add(hn::Set(d, float(s.y0) + 0.5f), hn::Combine(d, hn::Set(dh, 1.f), hn::Zero(dh)));  // rows y, y + 1
     const V two = hn::Set(d, 2.f);
