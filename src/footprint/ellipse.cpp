@@ -116,7 +116,8 @@ double SphereProjection::affineIndexError() const {
 }
 
 glm::dvec3 pixelRay(const SphereProjection& s, const PixelCoord& p) {
-    return {(p.x - s.principal.x) / s.f, -(p.y - s.principal.y) / s.f, 1.0};
+    const double invF = 1.0 / s.f;  // (as makeExactIndexMap and the lane projection, which mirrors it)
+    return {(p.x - s.principal.x) * invF, -(p.y - s.principal.y) * invF, 1.0};
 }
 
 bool rayHitsSphere(const SphereProjection& s, const PixelCoord& p) {

@@ -61,11 +61,10 @@ double exactIndexD2(const ScreenKernel& k, const SphereProjection& e, const Pixe
 
 ExactIndexMap makeExactIndexMap(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& origin) {
     // p' = k.centre + S·(p − k.centre) = [k.centre + S·(origin − k.centre)] + S·δ, and
-    // pixelRay(p') = ((p'.x − pp.x)/f, −(p'.y − pp.y)/f, 1) is affine in p'.
-    // (pixelRay with 1/f once: the lane projection mirrors these operations.)
+    // pixelRay(p') = ((p'.x − pp.x)·(1/f), −(p'.y − pp.y)·(1/f), 1) is affine in p'. The lane
+    // projection mirrors these operations.
     const double invF = 1.0 / e.f;
-    const glm::dvec2 p0 = k.centre + k.pullback * (origin - k.centre);
-    const glm::dvec3 v0((p0.x - e.principal.x) * invF, -(p0.y - e.principal.y) * invF, 1.0);
+    const glm::dvec3 v0 = pixelRay(e, k.centre + k.pullback * (origin - k.centre));
     const glm::dvec3 vx(k.pullback[0].x * invF, -k.pullback[0].y * invF, 0.0);  // S·(1, 0) = column 0
     const glm::dvec3 vy(k.pullback[1].x * invF, -k.pullback[1].y * invF, 0.0);
     ExactIndexMap m;
