@@ -61,6 +61,7 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
         const float* entries = reinterpret_cast<const float*>(table.entries());
         const V scale = hn::Set(d, table.scale()), offset = hn::Set(d, table.offset());
         const V zero = hn::Zero(d), top = hn::Set(d, float(ClassificationTable::kSize - 1));
+        const V transparent = hn::Set(d, table.transparentBelow());
         const auto lastLeft = hn::Set(di, ClassificationTable::kSize - 2);
         // The entries as pairs of floats in 64-bit lanes (half as many lanes as d).
         const hn::Repartition<double, decltype(d)> dd;
@@ -90,6 +91,10 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
                         // ClassificationTable::operator(): x = clamp(v·scale + offset), i = min(⌊x⌋,
                         // size − 2), the two entries lerped by x − i (the same float operations).
                         const V t0 = hn::IfThenElseZero(active, hn::Min(hn::Max(hn::Add(hn::Mul(value, scale), offset), zero), top));
+                        // A vector of transparent voxels (σ = 0 exactly, so every sum takes +0 and
+                        // no count): no gathers. Most of a CT's air and soft tissue under a bone
+                        // transfer function.
+                        if (hn::AllTrue(d, hn::Lt(t0, transparent))) continue;
                         const auto i = hn::Min(hn::ConvertTo(di, t0), lastLeft);
                         const V t = hn::Sub(t0, hn::ConvertTo(d, i));
                         // Entries i and i + 1 by pairs of floats: (r, g) and (b, σ) are 8 bytes each,

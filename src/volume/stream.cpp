@@ -608,6 +608,10 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
         tbb::parallel_for(tbb::blocked_range<size_t>(first, nextBlock_, 16), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 const Block& b = blocks_[i];
+                if (i + 1 < r.end() && blocks_[i + 1].leaf) {
+                    const char* next = reinterpret_cast<const char*>(blocks_[i + 1].leaf->buffer().data());
+                    for (int line = 0; line < 32; ++line) __builtin_prefetch(next + 64 * line);
+                }
                 VoxelBatch& e = extracted_[i - first];
                 e.clear();
                 if (hidden) {

@@ -395,6 +395,9 @@ ClassificationTable::ClassificationTable(std::vector<Classified> entries, float 
     if (!entries_.empty() && entries_.size() != size_t(kSize))
         throw Error("classification table: expected " + std::to_string(kSize) + " entries, got " +
                     std::to_string(entries_.size()));
+    // The first entry with σ > 0 (or kSize): below index first − 1 both lerped entries are 0.
+    const auto first = std::find_if(entries_.begin(), entries_.end(), [](const Classified& c) { return !(c.sigma <= 0.f); });
+    transparentBelow_ = float(std::distance(entries_.begin(), first)) - 1.f;
 }
 
 bool ClassificationTable::empty() const {

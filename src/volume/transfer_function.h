@@ -60,11 +60,16 @@ public:
     const Classified* entries() const { return entries_.empty() ? nullptr : entries_.data(); }
     float scale() const { return scale_; }
     float offset() const { return offset_; }
+    /// @brief Every index x < transparentBelow() (x = value·scale + offset, clamped) classifies to
+    /// σ = 0 exactly: both entries operator() lerps have σ = 0. −1 when entry 0 has σ ≠ 0 (or is
+    /// NaN); kSize − 1 when no entry is positive. Lets vectorised passes skip transparent voxels.
+    float transparentBelow() const { return transparentBelow_; }
 
 private:
     std::vector<Classified> entries_;
     float scale_ = float(kSize - 1);  ///< index = value · scale_ + offset_
     float offset_ = 0.f;
+    float transparentBelow_ = -1.f;  ///< see transparentBelow()
 };
 
 /// @brief A piecewise-linear transfer function over the normalised value x ∈ [0, 1].
