@@ -209,15 +209,22 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
     const V cx = hn::Set(d, s.cx);
     const V rgb[3] = {hn::Set(d, s.color.x), hn::Set(d, s.color.y), hn::Set(d, s.color.z)};
     const int rows = s.y1 - s.y0 + 1;
+    const uint32_t kLaneBits = uint32_t((uint64_t(1) << n) - 1);
     for (int k = 0; k < rows; ++k) {
         const int xa = q.xa[k], xb = q.xb[k];
         if (xa > xb) continue;
         const V i0 = hn::Set(d, q.i0[k]), i1 = hn::Set(d, q.i1[k]);
         const int row = (s.y0 + k - tile.y0) * kStride;
-        for (int from = xa; from <= xb; from += n) {
+        // The chord's pixels not yet drawn, one bit per tile column (0 ≤ xa ≤ xb < kStride).
+        uint32_t left = uint32_t((uint64_t(2) << xb) - (uint64_t(1) << xa));
+        while (left != 0) {
+            const int from = std::countr_zero(left);
             const int c = std::min(from, kStride - n);  // the vector's first pixel, inside the row
             // Lanes [from − c, xb − c]: the chord's pixels the previous vector has not drawn.
-            const auto chord = hn::AndNot(hn::FirstN(d, size_t(from - c)), hn::FirstN(d, size_t(std::min(xb - c + 1, n))));
+            const uint32_t lanes = (left >> c) & kLaneBits;
+            left &= ~(kLaneBits << c);
+            uint8_t laneBytes[8] = {uint8_t(lanes), uint8_t(lanes >> 8)};
+            const auto chord = hn::LoadMaskBits(d, laneBytes);
             const V dx = hn::Sub(hn::Add(hn::Set(d, float(tile.x0 + c)), lane), cx);  // pixel centre − cx
             const V i2 = hn::MulAdd(hn::MulAdd(qxx, dx, i1), dx, i0);
             float* pt = tile.T + row + c;
