@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <optional>
+#include <type_traits>
 
 #include "footprint/ellipsoid.h"
 #include "footprint/kernel.h"
@@ -558,16 +559,33 @@ void VoxelStream::adaptWindow(size_t released) {
 }
 
 namespace {
-/// Record @p i of @p src appended at @p k of @p dst (already sized).
-void copyRecord(const VoxelBatch& src, size_t i, VoxelBatch& dst, size_t k) {
-    dst.viewPos[k] = src.viewPos[i];
-    dst.distance[k] = src.distance[i];
-    dst.sigma[k] = src.sigma[i];
-    dst.color[k] = src.color[i];
-    dst.spread[k] = src.spread[i];
-    if (dst.withDepthSpread) dst.depthSpread[k] = src.depthSpread[i];
-    dst.members[k] = src.members[i];
-}
+/// A batch's arrays as raw pointers (@p B: VoxelBatch, or const VoxelBatch for a source), taken
+/// once per source: a record copied through the vectors would load each vector's data pointer
+/// again after every store (the stores may alias them).
+template <class B, class F = std::conditional_t<std::is_const_v<B>, const float, float>,
+          class V3 = std::conditional_t<std::is_const_v<B>, const glm::vec3, glm::vec3>,
+          class U = std::conditional_t<std::is_const_v<B>, const uint32_t, uint32_t>>
+struct RecordArrays {
+    V3* viewPos;
+    F *distance, *sigma;
+    V3* color;
+    F *spread, *depthSpread;  ///< null without depth spreads
+    U* members;
+    explicit RecordArrays(B& b)
+        : viewPos(b.viewPos.data()), distance(b.distance.data()), sigma(b.sigma.data()), color(b.color.data()),
+          spread(b.spread.data()), depthSpread(b.withDepthSpread ? b.depthSpread.data() : nullptr),
+          members(b.members.data()) {}
+    /// Record @p i of @p src copied to record @p k here.
+    void copy(const RecordArrays<const VoxelBatch>& src, size_t i, size_t k) const {
+        viewPos[k] = src.viewPos[i];
+        distance[k] = src.distance[i];
+        sigma[k] = src.sigma[i];
+        color[k] = src.color[i];
+        spread[k] = src.spread[i];
+        if (depthSpread) depthSpread[k] = src.depthSpread[i];
+        members[k] = src.members[i];
+    }
+};
 }  // namespace
 
 // The sources, in order: the pending voxels in fixed chunks, then each new block's voxels. Each
@@ -599,12 +617,13 @@ void VoxelStream::release(size_t blocks, float limit, VoxelBatch& batch) {
     batch.withDepthSpread = pendingNext_.withDepthSpread = options_.depthSpread;
     batch.resize(released[sources]);
     pendingNext_.resize(kept[sources]);
+    const RecordArrays<VoxelBatch> toBatch(batch), toPending(pendingNext_);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, sources, 16), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t s = r.begin(); s < r.end(); ++s) {
             size_t begin, end, out = released[s], stay = kept[s];
-            const VoxelBatch& src = source(s, begin, end);
+            const RecordArrays<const VoxelBatch> src(source(s, begin, end));
             for (size_t i = begin; i < end; ++i)
-                src.distance[i] < limit ? copyRecord(src, i, batch, out++) : copyRecord(src, i, pendingNext_, stay++);
+                src.distance[i] < limit ? toBatch.copy(src, i, out++) : toPending.copy(src, i, stay++);
         }
     });
     std::swap(pending_, pendingNext_);
