@@ -569,11 +569,13 @@ struct RecordArrays {
     V3* viewPos;
     F *distance, *sigma;
     V3* color;
-    F *spread, *depthSpread;  ///< null without depth spreads
+    F *spread, *depthSpread;  ///< a destination's: null without depth spreads
     U* members;
     explicit RecordArrays(B& b)
         : viewPos(b.viewPos.data()), distance(b.distance.data()), sigma(b.sigma.data()), color(b.color.data()),
-          spread(b.spread.data()), depthSpread(b.withDepthSpread ? b.depthSpread.data() : nullptr),
+          // A destination without depth spreads gets none; a source is read only where its
+          // destination keeps them (then every batch of the stream has them).
+          spread(b.spread.data()), depthSpread(std::is_const_v<B> || b.withDepthSpread ? b.depthSpread.data() : nullptr),
           members(b.members.data()) {}
     /// Record @p i of @p src copied to record @p k here.
     void copy(const RecordArrays<const VoxelBatch>& src, size_t i, size_t k) const {
