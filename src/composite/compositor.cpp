@@ -597,6 +597,7 @@ void TileCompositor::drawSplat(const TileRecord& p, const ExactIndexMap& map, Ti
         s.cx = p.centre.x, s.cy = p.centre.y;
         s.qxx = p.shape.x, s.qxy = p.shape.y, s.qyy = p.shape.z;
         s.scale = p.scale;
+        s.series = opacitySeriesFor(p.scale * tables_.poly.peak());
         s.coef = exactIndex ? tables_.poly.axisRow() : tables_.poly.row(p.sin2Alpha);
         s.exactIndex = exactIndex;
         if (exactIndex) s.map = map;

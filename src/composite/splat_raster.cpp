@@ -71,7 +71,24 @@ HWY_INLINE V Tau(D d, const SplatRaster& s, V dx, V dy, V i2, M& mask) {
 /// Engine's compositing when it served every vector). Semi-transparent volumes are almost all
 /// series; an opaque voxel's deposits take Expm1.
 template <class D, class V = hn::Vec<D>>
-HWY_INLINE V OpacityFromTau(D d, V tau) {
+HWY_INLINE V OpacityFromTau(D d, V tau, OpacitySeries series = OpacitySeries::Any) {
+    // A splat whose every τ is small (opacitySeriesFor): a shorter series, no test per vector.
+    if (series == OpacitySeries::Degree4) {
+        V p = hn::Set(d, -1.f / 24.f);
+        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 6.f));
+        p = hn::MulAdd(p, tau, hn::Set(d, -0.5f));
+        p = hn::MulAdd(p, tau, hn::Set(d, 1.f));
+        return hn::Mul(p, tau);
+    }
+    if (series == OpacitySeries::Degree6) {
+        V p = hn::Set(d, -1.f / 720.f);
+        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 120.f));
+        p = hn::MulAdd(p, tau, hn::Set(d, -1.f / 24.f));
+        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 6.f));
+        p = hn::MulAdd(p, tau, hn::Set(d, -0.5f));
+        p = hn::MulAdd(p, tau, hn::Set(d, 1.f));
+        return hn::Mul(p, tau);
+    }
     if (hn::AllTrue(d, hn::Lt(tau, hn::Set(d, 0.5f)))) {
         V p = hn::Set(d, -1.f / 40320.f);
         p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 5040.f));
@@ -116,7 +133,7 @@ HWY_INLINE void Deposit(D d, const SplatRaster& s, const TileBuffers& tile, V ta
     if constexpr (kSlabs) {
         DepositSlabs(d, s, tau, mask, load, store);
     } else {
-        const V ta = hn::Mul(T, OpacityFromTau(d, tau));  // T·α
+        const V ta = hn::Mul(T, OpacityFromTau(d, tau, s.series));  // T·α
         const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
         store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[0], R), R));
         store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[1], G), G));

@@ -69,6 +69,12 @@ FootprintPolynomials FootprintPolynomials::build(const KernelShape& kernel) {
     p.sin2Max_ = s * s;
     p.rows_.reserve(kRows + 1);
     for (int r = 0; r <= kRows; ++r) p.rows_.push_back(fitRow(p.sin2Max_ * r / kRows, kernel));
+    // The largest value any row takes (a splat's row is a convex combination of two), sampled
+    // densely; F falls with t, so it is F(0) up to the fit's error. A margin for between samples.
+    float peak = 0.f;
+    for (const Coefficients& c : p.rows_)
+        for (int k = 0; k <= 1024; ++k) peak = std::max(peak, evaluate(c, float(k) / 1024.f));
+    p.peak_ = peak * 1.001f;
     return p;
 }
 

@@ -55,12 +55,16 @@ public:
     static float evaluate(const Coefficients& c, float t);
 
     double sin2Max() const { return sin2Max_; }
+    /// @brief An upper bound on evaluate() over every row and t (F(0) and a margin): a splat's τ
+    /// is at most its scale times this (SplatRaster::series).
+    float peak() const { return peak_; }
     /// @brief Max |evaluate − Kernel::footprint| / F(0) over a dense sampling of t and α.
     double measureError(const KernelShape& kernel = KernelShape::standard()) const;
 
 private:
     std::vector<Coefficients> rows_;  // kRows + 1
     double sin2Max_ = 0.0;
+    float peak_ = 0.f;
 };
 
 }  // namespace vdbsplat

@@ -36,6 +36,7 @@ struct TileArrays {
 
 void vectorLoopMatchesTheScalarLoop();
 void nonFiniteConicStaysInsideItsRange();
+void shortOpacitySeriesMatchTheGeneralForm();
 
 /// Runs @p body once per SIMD target compiled in (foreach_target) that this CPU supports, each
 /// chosen by the runtime dispatch in turn (SSE4, AVX2, AVX-512, and the scalar fallback on x86),
@@ -56,42 +57,50 @@ void forEachTarget(F body) {
 // table index and for the exact index, with some pixels already finished (T < ε).
 TEST(SplatRaster, VectorLoopMatchesTheScalarLoop) { forEachTarget([] { vectorLoopMatchesTheScalarLoop(); }); }
 
-void vectorLoopMatchesTheScalarLoop() {
-    std::mt19937 rng(11);
+/// A random splat of a real kernel sphere in front of a 64² camera, possibly off-axis and near
+/// (@p exactIndex: the exact index), clipped to the tile under its centre (@p tx0, @p ty0), and
+/// random tile pixels with some already finished (T < ε). False when there is nothing to draw.
+bool randomSplat(std::mt19937& rng, bool exactIndex, SplatRaster& s, int& tx0, int& ty0, TileArrays& a) {
     std::uniform_real_distribution<float> u(0.f, 1.f);
     const Camera camera = testCamera(64);
+    const glm::dvec3 c((u(rng) - 0.5f) * 6.0, (u(rng) - 0.5f) * 6.0, 6.0 + u(rng) * 30.0);
+    const SphereProjection sphere = projectSphere(camera, ViewPoint(c), Kernel::kRadius * (0.2 + u(rng)));
+    if (!sphere.isEllipse()) return false;
+    const ScreenKernel k = makeScreenKernel(sphere);
+    s = SplatRaster{};
+    s.cx = float(k.centre.x), s.cy = float(k.centre.y);
+    s.qxx = float(k.conic[0][0]), s.qxy = float(k.conic[0][1]), s.qyy = float(k.conic[1][1]);
+    s.scale = 0.05f + 3.f * u(rng);
+    s.exactIndex = exactIndex;
+    const double sin2 = (sphere.r / sphere.D) * (sphere.r / sphere.D);
+    if (!s.exactIndex && !tables().poly.covers(sin2)) return false;
+    s.coef = s.exactIndex ? tables().poly.axisRow() : tables().poly.row(sin2);
+    s.map = makeExactIndexMap(k, sphere, PixelCoord(s.cx, s.cy));
+    s.color = glm::vec3(u(rng), u(rng), u(rng));
+    s.epsilon = kTransmittanceEpsilon;
+    constexpr int kLastTile = 64 / kTileSize - 1;
+    tx0 = std::clamp(int(std::floor(s.cx / kTileSize)), 0, kLastTile) * kTileSize;
+    ty0 = std::clamp(int(std::floor(s.cy / kTileSize)), 0, kLastTile) * kTileSize;
+    const PixelRange r = pixelRange(k.bounds, 64, 64);
+    s.x0 = std::max(r.x0, tx0), s.x1 = std::min(r.x1, tx0 + kTileSize - 1);
+    s.y0 = std::max(r.y0, ty0), s.y1 = std::min(r.y1, ty0 + kTileSize - 1);
+    if (s.x0 > s.x1 || s.y0 > s.y1) return false;
+    for (size_t i = 0; i < size_t(kTilePixels); ++i) {
+        a.T[i] = u(rng) < 0.1f ? 0.5f * kTransmittanceEpsilon : u(rng);
+        a.R[i] = u(rng), a.G[i] = u(rng), a.B[i] = u(rng);
+    }
+    return true;
+}
+
+void vectorLoopMatchesTheScalarLoop() {
+    std::mt19937 rng(11);
     double worst = 0.0;
     int drawn = 0;
     for (int trial = 0; trial < 300; ++trial) {
-        // A real kernel sphere in front of the camera, possibly off-axis and near.
-        const glm::dvec3 c((u(rng) - 0.5f) * 6.0, (u(rng) - 0.5f) * 6.0, 6.0 + u(rng) * 30.0);
-        const SphereProjection sphere = projectSphere(camera, ViewPoint(c), Kernel::kRadius * (0.2 + u(rng)));
-        if (!sphere.isEllipse()) continue;
-        const ScreenKernel k = makeScreenKernel(sphere);
         SplatRaster s;
-        s.cx = float(k.centre.x), s.cy = float(k.centre.y);
-        s.qxx = float(k.conic[0][0]), s.qxy = float(k.conic[0][1]), s.qyy = float(k.conic[1][1]);
-        s.scale = 0.05f + 3.f * u(rng);
-        s.exactIndex = trial % 2 == 1;
-        const double sin2 = (sphere.r / sphere.D) * (sphere.r / sphere.D);
-        if (!s.exactIndex && !tables().poly.covers(sin2)) continue;
-        s.coef = s.exactIndex ? tables().poly.axisRow() : tables().poly.row(sin2);
-        s.map = makeExactIndexMap(k, sphere, PixelCoord(s.cx, s.cy));
-        s.color = glm::vec3(u(rng), u(rng), u(rng));
-        s.epsilon = kTransmittanceEpsilon;
-        // The tile under the ellipse centre, clipped.
-        constexpr int kLastTile = 64 / kTileSize - 1;
-        const int tx0 = std::clamp(int(std::floor(s.cx / kTileSize)), 0, kLastTile) * kTileSize;
-        const int ty0 = std::clamp(int(std::floor(s.cy / kTileSize)), 0, kLastTile) * kTileSize;
-        const PixelRange r = pixelRange(k.bounds, 64, 64);
-        s.x0 = std::max(r.x0, tx0), s.x1 = std::min(r.x1, tx0 + kTileSize - 1);
-        s.y0 = std::max(r.y0, ty0), s.y1 = std::min(r.y1, ty0 + kTileSize - 1);
-        if (s.x0 > s.x1 || s.y0 > s.y1) continue;
+        int tx0 = 0, ty0 = 0;
         TileArrays a, b;
-        for (size_t i = 0; i < size_t(kTilePixels); ++i) {
-            a.T[i] = u(rng) < 0.1f ? 0.5f * kTransmittanceEpsilon : u(rng);
-            a.R[i] = u(rng), a.G[i] = u(rng), a.B[i] = u(rng);
-        }
+        if (!randomSplat(rng, trial % 2 == 1, s, tx0, ty0, a)) continue;
         b = a;
         const TileArrays before = a;
         drawSplatVector(s, a.buffers(tx0, ty0));
@@ -112,6 +121,49 @@ void vectorLoopMatchesTheScalarLoop() {
     std::printf("  max |vector − scalar| = %.3g over %d changed values\n", worst, drawn);
     EXPECT_GT(drawn, 1000);  // the loops did draw
     EXPECT_LT(worst, 2e-6);
+}
+
+// The short opacity series (OpacitySeries) a splat takes when every τ it deposits is small give
+// the general form's values to float rounding, at the edges of their ranges (τ up to 0.03 and
+// 0.2): a range too wide for its series (Degree4 up to 0.2: error 1.3e−5) fails here. The bound
+// FootprintPolynomials::peak() covers every row's polynomial.
+TEST(SplatRaster, ShortOpacitySeriesMatchTheGeneralForm) { forEachTarget([] { shortOpacitySeriesMatchTheGeneralForm(); }); }
+
+void shortOpacitySeriesMatchTheGeneralForm() {
+    EXPECT_EQ(opacitySeriesFor(std::numeric_limits<float>::quiet_NaN()), OpacitySeries::Any);
+    EXPECT_EQ(opacitySeriesFor(0.03f), OpacitySeries::Degree4);
+    EXPECT_EQ(opacitySeriesFor(0.2f), OpacitySeries::Degree6);
+    EXPECT_EQ(opacitySeriesFor(0.21f), OpacitySeries::Any);
+    const float peak = tables().poly.peak();
+    EXPECT_GE(peak, FootprintPolynomials::evaluate(tables().poly.axisRow(), 0.f));
+    EXPECT_LE(peak, 1.01f * float(Kernel::footprint(0.0)));
+    std::mt19937 rng(5);
+    for (const float tauBound : {0.03f, 0.2f}) {
+        double worst = 0.0;
+        int drawn = 0;
+        for (int trial = 0; trial < 200; ++trial) {
+            SplatRaster s;
+            int tx0 = 0, ty0 = 0;
+            TileArrays a, b;
+            if (!randomSplat(rng, trial % 2 == 1, s, tx0, ty0, a)) continue;
+            s.scale = 0.9999f * tauBound / peak;  // the largest τ at the range's end
+            s.color = glm::vec3(1.f);
+            a.T.fill(1.f), a.R.fill(0.f);  // one deposit on a clear tile: R = α
+            b = a;
+            drawSplatVector(s, b.buffers(tx0, ty0));  // Any: the general form
+            s.series = opacitySeriesFor(s.scale * peak);
+            EXPECT_NE(s.series, OpacitySeries::Any);
+            drawSplatVector(s, a.buffers(tx0, ty0));
+            for (size_t i = 0; i < size_t(kTilePixels); ++i) {
+                if (!(b.R[i] > 0.f)) continue;
+                ++drawn;
+                worst = std::max(worst, std::abs(double(a.R[i]) - double(b.R[i])) / double(b.R[i]));
+            }
+        }
+        std::printf("  τ ≤ %.2f: max |α_short − α_general| / α = %.3g over %d pixels\n", tauBound, worst, drawn);
+        EXPECT_GT(drawn, 1000);
+        EXPECT_LT(worst, 1e-6) << "tau bound " << tauBound;
+    }
 }
 
 // A splat whose conic or centre is not finite (or degenerate) draws nothing outside its clipped
