@@ -28,13 +28,13 @@ TEST(FootprintPoly, WithinTheStatedBoundOfTheClosedForm) {
 // reindex d² = t / (cos²α + t sin²α).
 TEST(FootprintPoly, PinnedValues) {
     const double f0 = Kernel::footprint(0.0);
-    EXPECT_NEAR(FootprintPolynomials::evaluate(poly().axisRow(), 0.f), f0, 1e-6 * f0);
+    EXPECT_NEAR(FootprintPolynomials::evaluate(poly().axisRow(), 0.f), f0, FootprintPolynomials::kErrorBound * f0);
     EXPECT_EQ(FootprintPolynomials::evaluate(poly().axisRow(), 1.f), 0.f);
     EXPECT_LT(FootprintPolynomials::evaluate(poly().axisRow(), 0.9999f), 0.02 * f0);
     const double a = 10.0 * std::numbers::pi / 180.0, s2 = std::sin(a) * std::sin(a), t = 0.25;
     const double d2 = t / ((1.0 - s2) + t * s2);
     EXPECT_NEAR(FootprintPolynomials::evaluate(poly().row(s2), float(t)), Kernel::footprint(Kernel::kRadius * std::sqrt(d2)),
-                2e-6 * f0);
+                FootprintPolynomials::kErrorBound * f0);
 }
 
 // The polynomial and the two-table path (the oracle) agree to within both their errors.
