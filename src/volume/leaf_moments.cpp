@@ -7,6 +7,7 @@
 
 #include <cstring>
 
+#include "volume/classify-inl.h"
 #include "volume/leaf_moments.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -56,18 +57,8 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
         const int lanes = int(hn::Lanes(d)), rowsPerVector = lanes / kLeafSide;
         const int side = 1 << level, cells = kLeafSide >> level;
         const float half = 0.5f * float(side - 1);
-        // The baked entries as floats: colour r, g, b, then σ, four per entry (Classified).
-        static_assert(sizeof(Classified) == 4 * sizeof(float), "Classified is {vec3 colour, float σ}");
-        const float* entries = reinterpret_cast<const float*>(table.entries());
-        const V scale = hn::Set(d, table.scale()), offset = hn::Set(d, table.offset());
-        const V zero = hn::Zero(d), top = hn::Set(d, float(ClassificationTable::kSize - 1));
-        const V transparent = hn::Set(d, table.transparentBelow());
-        const auto lastLeft = hn::Set(di, ClassificationTable::kSize - 2);
-        // The entries as pairs of floats in 64-bit lanes (half as many lanes as d).
-        const hn::Repartition<double, decltype(d)> dd;
-        const hn::RebindToSigned<decltype(dd)> dl;
-        const hn::Half<decltype(di)> dih;
-        const double* pairBase = reinterpret_cast<const double*>(entries);
+        const ClassifyLanes<D> classify(d, table);
+        const V zero = hn::Zero(d);
         // Per lane: its z (lane mod 8) and row within the vector (lane / 8).
         const auto lane = hn::Iota(di, 0);
         const auto laneZ = hn::And(lane, hn::Set(di, kLeafSide - 1));
@@ -81,40 +72,18 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
                     for (int y = cy * side; y < (cy + 1) * side; y += rowsPerVector) {
                         const int n = x * 64 + y * 8;
                         const V value = hn::LoadU(d, values + n);
-                        auto active = hn::IsFinite(value);
-                        if (maskWords) {
-                            const uint64_t bits = maskWords[x] >> (n & 63);
-                            uint8_t bytes[8];
-                            std::memcpy(bytes, &bits, sizeof bytes);
-                            active = hn::And(active, hn::LoadMaskBits(d, bytes));
-                        }
-                        // ClassificationTable::operator(): x = clamp(v·scale + offset), i = min(⌊x⌋,
-                        // size − 2), the two entries lerped by x − i (the same float operations).
-                        const V t0 = hn::IfThenElseZero(active, hn::Min(hn::Max(hn::Add(hn::Mul(value, scale), offset), zero), top));
+                        const auto active = ActiveLanes(d, value, maskWords, n);
+                        const V index = classify.Index(value, active);
                         // A vector of transparent voxels (σ = 0 exactly, so every sum takes +0 and
                         // no count): no gathers. Most of a CT's air and soft tissue under a bone
                         // transfer function.
-                        if (hn::AllTrue(d, hn::Lt(t0, transparent))) continue;
-                        const auto i = hn::Min(hn::ConvertTo(di, t0), lastLeft);
-                        const V t = hn::Sub(t0, hn::ConvertTo(d, i));
-                        // Entries i and i + 1 by pairs of floats: (r, g) and (b, σ) are 8 bytes each,
-                        // so 64-bit gathers fetch two channels at once (half the element loads of
-                        // one 32-bit gather per channel and entry), and even/odd lanes split them.
-                        // The same floats, so the same sums as before, bit for bit.
-                        const auto iLo = hn::PromoteTo(dl, hn::LowerHalf(dih, i)), iHi = hn::PromoteTo(dl, hn::UpperHalf(dih, i));
-                        const auto pairs = [&](int64_t first, V& even, V& odd) {  // first: 0 (r, g), 1 (b, σ); +2: entry i + 1
-                            const V lo = hn::BitCast(d, hn::GatherIndex(dd, pairBase, hn::Add(hn::ShiftLeft<1>(iLo), hn::Set(dl, first))));
-                            const V hi = hn::BitCast(d, hn::GatherIndex(dd, pairBase, hn::Add(hn::ShiftLeft<1>(iHi), hn::Set(dl, first))));
-                            even = hn::ConcatEven(d, hi, lo), odd = hn::ConcatOdd(d, hi, lo);
-                        };
-                        V r0, g0, b0, s0, r1, g1, b1, s1;
-                        pairs(0, r0, g0), pairs(1, b0, s0), pairs(2, r1, g1), pairs(3, b1, s1);
-                        const auto lerp = [&](V lo, V hi) { return hn::Add(lo, hn::Mul(t, hn::Sub(hi, lo))); };
-                        const V sigma = hn::IfThenElseZero(active, lerp(s0, s1));
+                        if (classify.AllTransparent(index)) continue;
+                        V sigma, red, green, blue;
+                        classify(index, active, sigma, red, green, blue);
                         count = hn::Add(count, hn::IfThenElseZero(hn::Gt(sigma, zero), hn::Set(d, 1.f)));
-                        Er = hn::MulAdd(sigma, lerp(r0, r1), Er);
-                        Eg = hn::MulAdd(sigma, lerp(g0, g1), Eg);
-                        Eb = hn::MulAdd(sigma, lerp(b0, b1), Eb);
+                        Er = hn::MulAdd(sigma, red, Er);
+                        Eg = hn::MulAdd(sigma, green, Eg);
+                        Eb = hn::MulAdd(sigma, blue, Eb);
                         const V dx = hn::Set(d, float(x & (side - 1)) - half);
                         const V dy = hn::Add(hn::Set(d, float(y & (side - 1)) - half), laneRow);
                         const V sx = hn::Mul(sigma, dx), sy = hn::Mul(sigma, dy), sz = hn::Mul(sigma, dz);

@@ -16,6 +16,7 @@
 #include "footprint/kernel.h"
 #include "pointfilter/point_filter.h"
 #include "shading/shading_field.h"
+#include "volume/leaf_extract.h"
 #include "volume/leaf_moments.h"
 #include "util/error.h"
 #include "volume/emission.h"
@@ -371,6 +372,19 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
     if (!coarse && b.leaf && !shader_ && !emission_) {  // the plain case, word by word of the value mask
         const float* values = b.leaf->buffer().data();
         const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE;
+        if (options_.vectorExtract && table_.entries() && leafExtractSupported()) {  // a vector of rows at a time
+            std::array<uint64_t, 8> words;
+            for (int x = 0; x < 8; ++x) words[size_t(x)] = b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));
+            const LeafRecords to{out.viewPos.data() + first, out.distance.data() + first, out.sigma.data() + first,
+                                 out.color.data() + first};
+            k += extractLeafVoxels(values, dense ? nullptr : words.data(), table_, indexToView_,
+                                   glm::ivec3(b.origin.x(), b.origin.y(), b.origin.z()), to);
+            std::fill(out.spread.begin() + ptrdiff_t(first), out.spread.begin() + ptrdiff_t(k), 0.f);
+            if (options_.depthSpread) std::fill(out.depthSpread.begin() + ptrdiff_t(first), out.depthSpread.begin() + ptrdiff_t(k), 0.f);
+            std::fill(out.members.begin() + ptrdiff_t(first), out.members.begin() + ptrdiff_t(k), 1u);
+            out.resize(k);
+            return;
+        }
         const auto& M = indexToView_;
         for (int x = 0; x < kBlockDim; ++x) {
             uint64_t word = dense ? ~uint64_t(0) : b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));

@@ -126,6 +126,9 @@ struct StreamOptions {
     /// Whole-leaf aggregates (8³ cells) through the vectorised sums (volume/leaf_moments.h);
     /// false: the scalar row sums they are tested against (same moments to float rounding).
     bool vectorLeafMoments = true;
+    /// Plain leaves' voxels through the vectorised extraction (volume/leaf_extract.h); false: the
+    /// voxel-by-voxel path it is tested against (the same records, bit for bit).
+    bool vectorExtract = true;
     /// Each record's depth spread (VoxelBatch::depthSpread) for the slab order's profiles; off,
     /// the array is left empty: 4 bytes less per voxel to write and move (the 10⁸ cloud's stream
     /// spent 0.3 s on it, session 6).

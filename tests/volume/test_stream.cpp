@@ -357,6 +357,7 @@ TEST(Stream, BlendedLevelsKeepTheEnergy) {
 
 #include <hwy/targets.h>
 
+#include "volume/leaf_extract.h"
 #include "volume/leaf_moments.h"
 
 namespace vdbsplat {
@@ -439,6 +440,83 @@ void expectLeafMomentsMatchTheSums() {
         }
         ASSERT_GT(total, 100u);
     }
+}
+
+// The vectorised leaf extraction writes what the voxel-by-voxel path computes, bit for bit and in
+// the same order: each active voxel with σ > 0 (not NaN or infinite, not transparent under the
+// table, not masked off), its view position and distance in glm's double order rounded to
+// float, σ and colour as ClassificationTable::operator(). Partly active and dense leaves, a
+// camera off every axis; on the widest target and on AVX2 (one row per vector) where wider exist.
+void expectLeafExtractionMatchesTheVoxels();
+
+TEST(LeafExtract, EqualsTheVoxelByVoxelRecords) {
+    if (!leafExtractSupported()) GTEST_SKIP() << "this CPU's vectors do not hold whole 8-voxel rows (scalar path only)";
+    {
+        SCOPED_TRACE("best target");
+        expectLeafExtractionMatchesTheVoxels();
+    }
+#if HWY_ARCH_X86
+    if ((hwy::SupportedTargets() & HWY_AVX2) && hwy::SupportedTargets() != HWY_AVX2) {
+        hwy::SetSupportedTargetsForTest(HWY_AVX2);
+        ASSERT_TRUE(leafExtractSupported());
+        SCOPED_TRACE("AVX2");
+        expectLeafExtractionMatchesTheVoxels();
+        hwy::SetSupportedTargetsForTest(0);  // back to what the CPU has
+    }
+#endif
+}
+
+void expectLeafExtractionMatchesTheVoxels() {
+    std::vector<Classified> entries(ClassificationTable::kSize);
+    for (int i = 0; i < ClassificationTable::kSize; ++i) {
+        const float t = float(i) / float(ClassificationTable::kSize - 1);
+        entries[size_t(i)] = {glm::vec3(t, 1.f - t, 0.3f + 0.4f * t * t), t < 0.3f ? 0.f : 0.02f + 2.f * t};
+    }
+    const ClassificationTable table(entries, -0.5f, 2.f);
+    // An index-to-view transform off every axis, with a translation and an uneven scale (as
+    // VoxelStream's worldToView · indexToWorld; any affine map).
+    glm::dmat4 indexToView(1.0);
+    const double m[12] = {0.61, -0.33, 0.72, 0.29, 0.93, 0.17, -0.74, 0.13, 0.66, 0.37 * 3.1, -12.7, 583.3};
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) indexToView[c][r] = m[c * 3 + r] * (0.37 + 0.01 * c);
+    indexToView[3] = glm::dvec4(m[9], m[10], m[11], 1.0);
+    uint32_t state = 5;
+    const auto rnd = [&] { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1 << 24); };
+    size_t kept = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        std::array<float, 512> values;
+        std::array<uint64_t, 8> words{};
+        for (int n = 0; n < 512; ++n) {
+            values[size_t(n)] = -1.f + 4.f * rnd();
+            if (n % 97 == trial % 97) values[size_t(n)] = std::numeric_limits<float>::quiet_NaN();
+            if (n % 89 == trial % 89) values[size_t(n)] = std::numeric_limits<float>::infinity();
+            if (rnd() < 0.6f) words[size_t(n >> 6)] |= uint64_t(1) << (n & 63);
+        }
+        if (trial % 5 == 1) std::fill(values.begin(), values.begin() + 192, 0.1f);  // transparent rows
+        const bool dense = trial % 4 == 0;
+        const glm::ivec3 origin(8 * (trial % 3) - 8, 8 * (trial % 5), -16 + 8 * (trial % 7));
+        std::vector<glm::vec3> pos(512), color(512);
+        std::vector<float> distance(512), sigma(512);
+        const size_t n = extractLeafVoxels(values.data(), dense ? nullptr : words.data(), table, indexToView, origin,
+                                           LeafRecords{pos.data(), distance.data(), sigma.data(), color.data()});
+        size_t k = 0;
+        for (int i = 0; i < 512; ++i) {
+            if (!dense && !(words[size_t(i >> 6)] >> (i & 63) & 1)) continue;
+            const Classified c = table(values[size_t(i)]);
+            if (!(c.sigma > 0.f)) continue;
+            SCOPED_TRACE("trial " + std::to_string(trial) + ", voxel " + std::to_string(i));
+            ASSERT_LT(k, n);
+            const glm::dvec3 v = indexToView * glm::dvec4(glm::dvec3(origin) + glm::dvec3(i >> 6, (i >> 3) & 7, i & 7), 1.0);
+            EXPECT_EQ(pos[k], glm::vec3(v));
+            EXPECT_EQ(distance[k], float(glm::length(v)));
+            EXPECT_EQ(sigma[k], c.sigma);
+            EXPECT_EQ(color[k], c.color);
+            ++k;
+        }
+        EXPECT_EQ(n, k);
+        kept += k;
+    }
+    EXPECT_GT(kept, 3000u);
 }
 
 }  // namespace

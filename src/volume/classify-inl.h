@@ -1,0 +1,96 @@
+// volume/classify-inl.h — ClassificationTable::operator() on every lane of a Highway vector, with
+// its float operations (x = clamp(v·scale + offset), i = min(⌊x⌋, size − 2), the entries i and
+// i + 1 lerped by x − i), so the same values bit for bit. Shared by the level-of-detail moments
+// (volume/leaf_moments.cpp) and the leaf extraction (volume/leaf_extract.cpp); included once per
+// SIMD target from inside their foreach_target.h passes (Highway's per-target include guard),
+// after <hwy/highway.h>. Targets whose vectors hold 8 or 16 floats (the callers' row layout).
+#if defined(VDBSPLAT_CLASSIFY_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef VDBSPLAT_CLASSIFY_INL_H_
+#undef VDBSPLAT_CLASSIFY_INL_H_
+#else
+#define VDBSPLAT_CLASSIFY_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include "volume/transfer_function.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace vdbsplat {
+namespace HWY_NAMESPACE {
+
+#if HWY_TARGET != HWY_SCALAR
+/// The baked table's constants as vectors, set up once per leaf; @p table must not be empty().
+template <class D>
+struct ClassifyLanes {
+    using V = hwy::HWY_NAMESPACE::Vec<D>;
+    static_assert(sizeof(Classified) == 4 * sizeof(float), "Classified is {vec3 colour, float σ}");
+    D d;
+    V scale, offset, zero, top, transparent;
+    const double* pairs;  ///< the entries as pairs of floats: (r, g), (b, σ)
+
+    ClassifyLanes(D tag, const ClassificationTable& table)
+        : d(tag),
+          scale(hwy::HWY_NAMESPACE::Set(tag, table.scale())),
+          offset(hwy::HWY_NAMESPACE::Set(tag, table.offset())),
+          zero(hwy::HWY_NAMESPACE::Zero(tag)),
+          top(hwy::HWY_NAMESPACE::Set(tag, float(ClassificationTable::kSize - 1))),
+          transparent(hwy::HWY_NAMESPACE::Set(tag, table.transparentBelow())),
+          pairs(reinterpret_cast<const double*>(table.entries())) {}
+
+    /// The lanes' table index x (0 where !active).
+    template <class M>
+    V Index(V value, M active) const {
+        namespace hn = hwy::HWY_NAMESPACE;
+        return hn::IfThenElseZero(active, hn::Min(hn::Max(hn::Add(hn::Mul(value, scale), offset), zero), top));
+    }
+    /// Every lane's σ is 0 exactly (both lerped entries have σ = 0): nothing to classify.
+    bool AllTransparent(V x) const { return hwy::HWY_NAMESPACE::AllTrue(d, hwy::HWY_NAMESPACE::Lt(x, transparent)); }
+
+    /// σ (0 where !active) and the colour of index @p x. Entries i and i + 1 by pairs of floats:
+    /// (r, g) and (b, σ) are 8 bytes each, so 64-bit gathers fetch two channels at once (half the
+    /// element loads of one 32-bit gather per channel and entry), and even/odd lanes split them.
+    template <class M>
+    void operator()(V x, M active, V& sigma, V& r, V& g, V& b) const {
+        namespace hn = hwy::HWY_NAMESPACE;
+        const hn::RebindToSigned<D> di;
+        const hn::Repartition<double, D> dd;
+        const hn::RebindToSigned<decltype(dd)> dl;
+        const hn::Half<decltype(di)> dih;
+        const auto i = hn::Min(hn::ConvertTo(di, x), hn::Set(di, ClassificationTable::kSize - 2));
+        const V t = hn::Sub(x, hn::ConvertTo(d, i));
+        const auto iLo = hn::PromoteTo(dl, hn::LowerHalf(dih, i)), iHi = hn::PromoteTo(dl, hn::UpperHalf(dih, i));
+        const auto gather = [&](int64_t first, V& even, V& odd) {  // first: 0 (r, g), 1 (b, σ); +2: entry i + 1
+            const V lo = hn::BitCast(d, hn::GatherIndex(dd, pairs, hn::Add(hn::ShiftLeft<1>(iLo), hn::Set(dl, first))));
+            const V hi = hn::BitCast(d, hn::GatherIndex(dd, pairs, hn::Add(hn::ShiftLeft<1>(iHi), hn::Set(dl, first))));
+            even = hn::ConcatEven(d, hi, lo), odd = hn::ConcatOdd(d, hi, lo);
+        };
+        V r0, g0, b0, s0, r1, g1, b1, s1;
+        gather(0, r0, g0), gather(1, b0, s0), gather(2, r1, g1), gather(3, b1, s1);
+        const auto lerp = [&](V lo, V hi) { return hn::Add(lo, hn::Mul(t, hn::Sub(hi, lo))); };
+        sigma = hn::IfThenElseZero(active, lerp(s0, s1));
+        r = lerp(r0, r1), g = lerp(g0, g1), b = lerp(b0, b1);
+    }
+};
+
+/// A leaf's active lanes at voxel n (a vector of whole rows: n = x·64 + y·8): finite values,
+/// and on in @p maskWords (nullptr: a dense leaf).
+template <class D>
+HWY_INLINE auto ActiveLanes(D d, hwy::HWY_NAMESPACE::Vec<D> value, const uint64_t* maskWords, int n) {
+    namespace hn = hwy::HWY_NAMESPACE;
+    auto active = hn::IsFinite(value);
+    if (maskWords) {
+        const uint64_t bits = maskWords[n >> 6] >> (n & 63);
+        uint8_t bytes[8];
+        std::memcpy(bytes, &bits, sizeof bytes);
+        active = hn::And(active, hn::LoadMaskBits(d, bytes));
+    }
+    return active;
+}
+#endif  // HWY_TARGET != HWY_SCALAR
+
+}  // namespace HWY_NAMESPACE
+}  // namespace vdbsplat
+HWY_AFTER_NAMESPACE();
+
+#endif  // per-target include guard
