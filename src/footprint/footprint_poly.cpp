@@ -69,11 +69,11 @@ FootprintPolynomials FootprintPolynomials::build(const KernelShape& kernel) {
     p.sin2Max_ = s * s;
     p.rows_.reserve(kRows + 1);
     for (int r = 0; r <= kRows; ++r) p.rows_.push_back(fitRow(p.sin2Max_ * r / kRows, kernel));
-    // The largest value any row takes (a splat's row is a convex combination of two), sampled
-    // densely; F falls with t, so it is F(0) up to the fit's error. A margin for between samples.
+    // The largest value any row takes (a splat's row is a convex combination of two): F falls with
+    // t, so a row's largest is its value at t = 0 up to the fit's error (kErrorBound·F(0)), which
+    // the margin covers 100 times over (FootprintPoly.PeakBoundsEveryRow samples it densely).
     float peak = 0.f;
-    for (const Coefficients& c : p.rows_)
-        for (int k = 0; k <= 1024; ++k) peak = std::max(peak, evaluate(c, float(k) / 1024.f));
+    for (const Coefficients& c : p.rows_) peak = std::max(peak, evaluate(c, 0.f));
     p.peak_ = peak * 1.001f;
     return p;
 }

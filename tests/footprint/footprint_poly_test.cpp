@@ -54,6 +54,19 @@ TEST(FootprintPoly, AgreesWithTheTablePath) {
     EXPECT_LT(worst / Kernel::footprint(0.0), 2e-5);
 }
 
+// peak() bounds every row's polynomial over all t (and so every splat's row, a convex combination
+// of two): the splat loop's opacity series are chosen from it (composite/splat_raster.h).
+TEST(FootprintPoly, PeakBoundsEveryRow) {
+    float highest = 0.f;
+    for (int k = 0; k <= 400; ++k) {
+        const double s2 = poly().sin2Max() * k / 400.0;
+        const auto c = poly().row(s2);
+        for (int j = 0; j <= 4096; ++j) highest = std::max(highest, FootprintPolynomials::evaluate(c, float(j) / 4096.f));
+    }
+    EXPECT_GE(poly().peak(), highest);
+    EXPECT_LT(poly().peak(), 1.002f * highest);  // a tight bound: a loose one would send splats to longer series
+}
+
 TEST(FootprintPoly, CoversOnlyItsRange) {
     EXPECT_TRUE(poly().covers(0.0));
     EXPECT_TRUE(poly().covers(poly().sin2Max()));
