@@ -98,6 +98,17 @@ struct TileCompositor::SlabBuffer {
     alignas(64) std::array<float, kTileSize * kTileSize> eg{};
     alignas(64) std::array<float, kTileSize * kTileSize> eb{};
     bool dirty = false;
+    /// The image pixels the kernel order's points have deposited into since the slab was last
+    /// composited (x1 < x0: not tracked, the whole tile): compositing reads only those (a far
+    /// view's slab holds a few points of a tile's 1 024 pixels).
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+    void touch(int ax0, int ay0, int ax1, int ay1) {
+        if (x1 < x0) {
+            x0 = ax0, y0 = ay0, x1 = ax1, y1 = ay1;
+            return;
+        }
+        x0 = std::min(x0, ax0), y0 = std::min(y0, ay0), x1 = std::max(x1, ax1), y1 = std::max(y1, ay1);
+    }
 };
 
 /// --compositing slabs: one tile's open slabs [first, last] (last < first: none), slab s in
@@ -418,8 +429,13 @@ namespace {
 template <class Pixels, class Slab>
 void compositeSlab(Pixels& px, Slab& slab, bool skipFinished = false) {
     if (!slab.dirty) return;
-    for (int y = px.y0; y <= px.y1; ++y)
-        for (int x = px.x0; x <= px.x1; ++x) {
+    // Only where deposits were made, when known (elsewhere τ = 0: nothing to composite or clear).
+    const bool tracked = slab.x1 >= slab.x0;
+    const int xa = tracked ? std::max(px.x0, slab.x0) : px.x0, xb = tracked ? std::min(px.x1, slab.x1) : px.x1;
+    const int ya = tracked ? std::max(px.y0, slab.y0) : px.y0, yb = tracked ? std::min(px.y1, slab.y1) : px.y1;
+    slab.x0 = 0, slab.y0 = 0, slab.x1 = -1, slab.y1 = -1;
+    for (int y = ya; y <= yb; ++y)
+        for (int x = xa; x <= xb; ++x) {
             const int i = px.local(x, y);
             const size_t j = size_t(i);
             const float tau = slab.tau[j];
@@ -569,6 +585,7 @@ void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBu
     }
     const SlabTile tile{slab->tau.data(), slab->er.data(), slab->eg.data(), slab->eb.data(), px.T.data(), px.x0, px.y0};
     exact_.vector ? drawPointVector(r, tile) : drawPointScalar(r, tile);
+    if (r.x0 <= r.x1 && r.y0 <= r.y1) slab->touch(r.x0, r.y0, r.x1, r.y1);
     slab->dirty = true;
 }
 
