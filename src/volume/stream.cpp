@@ -518,6 +518,11 @@ void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, c
     const float half = 0.5f * float(side - 1);
     const glm::dmat3 toView(indexToView_);  // linear part: index offsets → view offsets
     const double f = camera_.focal();
+    // Sized for every cell first, written by index, cut to the cells kept (as extractVoxels; it
+    // also marks the batch's depth spreads kept or not, as every other record path does).
+    size_t k = out.size();
+    out.withDepthSpread = options_.depthSpread;
+    out.resize(k + size_t(cells * cells * cells));
     for (int cx = 0; cx < cells; ++cx)
         for (int cy = 0; cy < cells; ++cy)
             for (int cz = 0; cz < cells; ++cz) {
@@ -543,26 +548,28 @@ void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, c
                 const glm::dvec3 jx(f / v.z, 0.0, -f * v.x / (v.z * v.z)), jy(0.0, f / v.z, -f * v.y / (v.z * v.z));
                 const glm::dvec3 ux = jx * toView, uy = jy * toView;  // row vector · A = Aᵀj
                 const double spread = 0.5 * (glm::dot(ux, cov * ux) + glm::dot(uy, cov * uy));
-                out.viewPos.emplace_back(v);
-                out.distance.push_back(float(glm::length(v)));
-                out.sigma.push_back(weight == 1.f ? a.m : a.m * weight);
-                out.color.push_back(a.emission / a.m);
+                out.viewPos[k] = glm::vec3(v);
+                out.distance[k] = float(glm::length(v));
+                out.sigma[k] = weight == 1.f ? a.m : a.m * weight;
+                out.color[k] = a.emission / a.m;
                 // Only what exceeds a full cell's own second moment (s²·(n² − 1)/12 per index axis)
                 // is added: the cells' lattice already spreads a full cell's mass over the cell, as
                 // the voxels' lattice does a voxel's (a uniform region of cells is the same quadrature
                 // of the same field as its voxels, one level coarser). Adding it again blurred every
                 // surface by a cell (docs/animation.md, session 5).
                 const double full = (double(side) * side - 1.0) / 12.0 * 0.5 * (glm::dot(ux, ux) + glm::dot(uy, uy));
-                out.spread.push_back(float(std::max(spread - full, 0.0)));
+                out.spread[k] = float(std::max(spread - full, 0.0));
                 // Along the view ray the whole second moment counts (world²): the depth profile of the
                 // cell's mass (--compositing slabs, composite/slab_profile.h), ωᵀ A Σ Aᵀ ω.
                 if (options_.depthSpread) {
                     const glm::dvec3 uz = (v / glm::length(v)) * toView;
-                    out.depthSpread.push_back(float(std::max(glm::dot(uz, cov * uz), 0.0)));
+                    out.depthSpread[k] = float(std::max(glm::dot(uz, cov * uz), 0.0));
                 }
-                out.members.push_back(counted ? a.n : 0);
+                out.members[k] = counted ? a.n : 0;
+                ++k;
                 if (counted) ++counts.aggregates, counts.aggregatedVoxels += a.n;
             }
+    out.resize(k);
 }
 
 void VoxelStream::adaptWindow(size_t released) {
