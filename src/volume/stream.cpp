@@ -25,6 +25,7 @@ namespace vdbsplat {
 
 namespace {
 constexpr int kBlockDim = 8;  // OpenVDB leaf side; active tiles are split into blocks of this side
+constexpr size_t kMaxWindowBlocks = 512;  // a window grows past its slabs up to this many blocks (recordsOf)
 constexpr uint64_t kMaxActiveVoxels = uint64_t(1) << 32;
 }  // namespace
 
@@ -572,6 +573,19 @@ void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, c
     out.resize(k);
 }
 
+// A block's records, about: its voxels, or its cells at a level of detail (both levels' when
+// blended). Windows are sized by records, the work downstream: sized by voxels, a far view's
+// windows held a few thousand records each, and their fixed costs (a dozen parallel passes
+// each) outweighed their work.
+// Nor more than kMaxWindowBlocks blocks a window (while it grows past its slabs): each keeps
+// its own buffer (extracted_), and a one-shot render pays for every fresh one.
+size_t VoxelStream::recordsOf(const Block& b) {
+    if (b.lodLevel == 0) return b.voxels;
+    const size_t cells = size_t(1) << (3 * (kBlockDim == 8 ? 3 - b.lodLevel : 0));  // (8 >> ℓ)³
+    const size_t atLevel = std::min<size_t>(b.voxels, cells);
+    return b.lodFine > 0.f ? std::min<size_t>(b.voxels, 9 * atLevel) : atLevel;  // the finer level: 8× the cells
+}
+
 void VoxelStream::adaptWindow(size_t released) {
     const int widest = std::max(1, options_.slabsPerWindow);
     if (released > options_.maxWindowVoxels && slabsPerWindow_ > 1) slabsPerWindow_ /= 2;
@@ -665,9 +679,9 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
         size_t first = nextBlock_;
         size_t estimate = pending_.size();
         while (nextBlock_ < blocks_.size() && blocks_[nextBlock_].dMin < slabEnd * slabLength_) {
-            estimate += blocks_[nextBlock_].voxels;
+            estimate += recordsOf(blocks_[nextBlock_]);
             ++nextBlock_;
-            if (nextBlock_ < blocks_.size() && estimate < options_.minWindowVoxels &&
+            if (nextBlock_ < blocks_.size() && estimate < options_.minWindowVoxels && nextBlock_ - first < kMaxWindowBlocks &&
                 blocks_[nextBlock_].dMin >= slabEnd * slabLength_)
                 slabEnd = int64_t(std::floor(blocks_[nextBlock_].dMin / slabLength_)) + slabsPerWindow_;
         }

@@ -191,6 +191,7 @@ private:
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
     void lodLevel(Block& b) const;  // sets b.lodLevel and b.lodFine
+    static size_t recordsOf(const Block& b);  // about how many records b's extraction gives
     void extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const;  // counts: aggregates only
     void extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const;
     void cellMoments(const Block& b, int level, CellMoments* acc) const;

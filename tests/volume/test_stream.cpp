@@ -280,6 +280,31 @@ TEST(Stream, AggregatesMatchBruteForceMoments) {
     }
 }
 
+// Windows are sized by the records their blocks give, not by their voxels: at a far view, where
+// the level of detail draws a block as a few cells, a window takes many more blocks (up to 512),
+// so the cloud's 200 000 voxels (4 854 records) come in three windows instead of six of a few
+// hundred records each (a dozen parallel passes each, for little work). The records are the
+// same whatever the windows (ImagesDoNotDependOnThreadCountOrWindowSize renders it).
+TEST(Stream, FarWindowsAreSizedByRecords) {
+    const Volume& v = cloud();
+    const Camera camera = framedCamera(v, 256, 8.0);
+    const ClassificationTable table = constantTable(0.05f);
+    StreamOptions o;
+    o.pointBelowPx = 1.0;
+    o.lodCellPx = 1.25;
+    VoxelStream stream(v, camera, table, o);
+    VoxelBatch batch;
+    size_t windows = 0, records = 0;
+    uint64_t members = 0;
+    while (stream.next(batch)) {
+        ++windows, records += batch.size();
+        for (size_t i = 0; i < batch.size(); ++i) members += batch.members[i];
+    }
+    EXPECT_EQ(members, v.activeVoxels - stream.culledVoxels());  // every voxel, at some level
+    EXPECT_LT(records, v.activeVoxels / 8);                      // mostly aggregates
+    EXPECT_LE(windows, 3u) << records << " records";  // by voxels: 6
+}
+
 // Blended levels (StreamOptions::lodBlend): along a zoom through every level change the leaves
 // are drawn at two neighbouring levels with their optical depth split between them, so the
 // records' total mass Σσ is the voxels' at every camera (energy, DESIGN §8.2) and each voxel is
