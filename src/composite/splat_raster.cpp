@@ -40,11 +40,13 @@ HWY_INLINE V ExactT(D d, const SplatRaster& s, V dx, V dy) {
 }
 
 /// τ of the splat at index t (i², or the exact d²; the lanes of @p mask are those with t < 1):
-/// τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h).
+/// τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h). t ≥ 0 but for rounding (a few ulps
+/// below 0 at the centre, where the polynomial is as good), so only t ≤ 1 is enforced: the
+/// lanes outside the ellipse then stay finite, and the opacity's test per vector sees no NaN.
 template <class D, class V = hn::Vec<D>>
 HWY_INLINE V TauAt(D d, const SplatRaster& s, V t) {
     const V zero = hn::Zero(d), one = hn::Set(d, 1.f), two = hn::Set(d, 2.f);
-    t = hn::Min(hn::Max(t, zero), one);
+    t = hn::Min(t, one);
     const V x = hn::MulSub(two, t, one);
     V p = hn::Set(d, s.coef[FootprintPolynomials::kDegree]);
 #pragma GCC unroll 16
