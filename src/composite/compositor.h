@@ -109,6 +109,8 @@ public:
 
     /// @brief The image so far: premultiplied colour, alpha = 1 − T (after finish(): everything).
     Image image() const;
+    /// @brief The same frame, in place (valid while the compositor and its buffers are).
+    FrameView frame() const { return {color_.data(), transmittance_.data(), width_, height_}; }
 
 private:
     /// Whether a pixel of tile (@p tx, @p ty) inside the inclusive rectangle has T ≥ ε: the

@@ -53,6 +53,19 @@ struct Image {
     const glm::vec4& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
 };
 
+/// @brief A composited frame where the compositor keeps it (premultiplied radiance and
+/// transmittance T per pixel, row-major), read as RGBA with α = 1 − T without copying it into an
+/// Image first (a 1024² frame is 16 MB of fresh pages, a few milliseconds of page faults).
+struct FrameView {
+    const glm::vec3* color = nullptr;
+    const float* transmittance = nullptr;
+    int width = 0, height = 0;
+    glm::vec4 at(int x, int y) const {
+        const size_t i = size_t(y) * size_t(width) + size_t(x);
+        return glm::vec4(color[i], 1.f - transmittance[i]);
+    }
+};
+
 /// Largest image side readImage accepts (as render's --size): checked before any pixel is read.
 inline constexpr int kMaxImageSide = 16384;
 /// Most pixels readImage accepts (8192², about 2 GB while decoding): checked likewise.

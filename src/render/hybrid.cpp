@@ -1,10 +1,13 @@
 // render/hybrid.cpp — window-by-window forward resampling (see hybrid.h).
 #include "render/hybrid.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <optional>
 
 #include "composite/compositor.h"
@@ -39,10 +42,14 @@ struct ForwardPass {
     double lodPrefilterVariance;
 };
 
-/// Streams, projects and composites @p volume onto @p camera's pixels.
+/// What becomes of the composited frame: the output image made from it in place (copied, or
+/// postfiltered, into the final image's rectangle), while the compositor still holds it.
+using FrameSink = std::function<Image(const FrameView&)>;
+
+/// Streams, projects and composites @p volume onto @p camera's pixels; returns @p sink's image of the frame.
 Image composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, const Tables& tables,
                 const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
-                const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
+                const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission, const FrameSink& sink) {
     // The kernels' shape in view space (anisotropic or sheared voxels: ellipsoids).
     // view = R·(world − eye), R's rows right, up, forward: M = R·A.
     const glm::dmat3 worldToView = glm::transpose(glm::dmat3(camera.right(), camera.up(), camera.forward()));
@@ -125,7 +132,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     auto t = Clock::now();
     compositor.finish();
     stats.compositeSeconds += since(t);
-    return compositor.image();
+    return sink(compositor.frame());
 }
 
 /// How far (px) past the projection of a primitive's kernel sphere its deposits reach: a point's
@@ -175,11 +182,14 @@ double subpixelThreshold(double threshold, int k) {
     return std::min(threshold * k, std::max(threshold, kMaxPointSpacingSubpx));
 }
 
-/// A @p width × @p height image, transparent (T = 1, no radiance) except for @p part at (@p x0, @p y0).
-Image placed(const Image& part, int x0, int y0, int width, int height) {
+/// A @p width × @p height image, transparent (T = 1, no radiance) except for @p frame at (@p x0, @p y0):
+/// the rows copied in parallel; the rest is the image's zero pages, never touched.
+Image placed(const FrameView& frame, int x0, int y0, int width, int height) {
     Image out(width, height);
-    for (int y = 0; y < part.height; ++y)
-        std::copy_n(&part.at(0, y), part.width, &out.at(x0, y0 + y));
+    tbb::parallel_for(tbb::blocked_range<int>(0, frame.height, 16), [&](const tbb::blocked_range<int>& r) {
+        for (int y = r.begin(); y < r.end(); ++y)
+            for (int x = 0; x < frame.width; ++x) out.at(x0 + x, y0 + y) = frame.at(x, y);
+    });
     return out;
 }
 
@@ -198,11 +208,13 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
         const double v = none ? 0.0 : kPrefilterVariance;
         const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, v, v};
         const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, *tables.kernel), 0);
-        if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control, emission);
+        const auto at = [&](int x0, int y0) {
+            return [&camera, x0, y0](const FrameView& f) { return placed(f, x0, y0, camera.width(), camera.height()); };
+        };
+        if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control, emission, at(0, 0));
         const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
-        const Image part = composite(volume, table, camera.cropped(crop->x0, crop->y0, w, h), tables, settings, pass,
-                                     stats, shader, control, emission);
-        return placed(part, crop->x0, crop->y0, camera.width(), camera.height());
+        return composite(volume, table, camera.cropped(crop->x0, crop->y0, w, h), tables, settings, pass, stats, shader,
+                         control, emission, at(crop->x0, crop->y0));
     }
     // Postfilter: the same primitives (τ and the level of detail scaled to sub-pixels, so the
     // same voxels are points), composited at k× the resolution with only V_s folded in, then
@@ -217,14 +229,21 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     // image is that output rectangle with its own border, as subpixelCamera frames the whole image.
     const std::optional<PixelRange> crop =
         coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, *tables.kernel), grid.border);
-    if (!crop) {
-        const Image sub = composite(volume, table, fine, tables, settings, pass, stats, shader, control, emission);
-        return postfilterImage(sub, grid, camera.width(), camera.height());
-    }
+    // The postfilter reads the compositor's frame and writes the output image's rectangle.
+    const auto filtered = [&](int x0, int y0, int w, int h) {
+        return [&camera, &grid, x0, y0, w, h](const FrameView& f) {
+            Image out(camera.width(), camera.height());
+            postfilterInto(f, grid, w, h, out, x0, y0);
+            return out;
+        };
+    };
+    if (!crop)
+        return composite(volume, table, fine, tables, settings, pass, stats, shader, control, emission,
+                         filtered(0, 0, camera.width(), camera.height()));
     const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
     const Camera fineCrop = fine.cropped(k * crop->x0, k * crop->y0, k * (w + 2 * grid.border), k * (h + 2 * grid.border));
-    const Image sub = composite(volume, table, fineCrop, tables, settings, pass, stats, shader, control, emission);
-    return placed(postfilterImage(sub, grid, w, h), crop->x0, crop->y0, camera.width(), camera.height());
+    return composite(volume, table, fineCrop, tables, settings, pass, stats, shader, control, emission,
+                     filtered(crop->x0, crop->y0, w, h));
 }
 
 }  // namespace vdbsplat

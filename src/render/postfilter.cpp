@@ -2,11 +2,14 @@
 #include "render/postfilter.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "footprint/prefilter.h"
 #include "util/error.h"
@@ -51,34 +54,59 @@ PostfilterTaps postfilterTaps(const SubpixelGrid& grid) {
     return taps;
 }
 
-Image postfilterImage(const Image& fine, const SubpixelGrid& grid, int width, int height) {
+namespace {
+/// The separable filter a band of output rows at a time (postfilterInto): the band's sub-pixel rows
+/// filtered horizontally into its thread's buffer, then vertically into @p out.
+template <class Frame>
+void filterBands(const Frame& fine, const SubpixelGrid& grid, int width, int height, Image& out, int x0, int y0) {
     const PostfilterTaps taps = postfilterTaps(grid);
-    const int k = grid.k, fw = fine.width, n = int(taps.weights.size());
-    if (fw != k * (width + 2 * grid.border) || fine.height != k * (height + 2 * grid.border))
+    const int k = grid.k, n = int(taps.weights.size());
+    if (fine.width != k * (width + 2 * grid.border) || fine.height != k * (height + 2 * grid.border))
         throw Error("postfilter: the sub-pixel image does not match the grid");
-    // Horizontal pass: every sub-pixel row, output columns.
-    Image rows(width, fine.height);
-    tbb::parallel_for(tbb::blocked_range<int>(0, fine.height, 16), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y < r.end(); ++y)
-            for (int x = 0; x < width; ++x) {
-                const int s0 = k * (x + grid.border) + taps.first;
-                glm::vec4 sum(0.f);
-                for (int j = 0; j < n; ++j) sum += taps.weights[size_t(j)] * fine.at(s0 + j, y);
-                rows.at(x, y) = sum;
+    if (width < 0 || height < 0 || x0 < 0 || y0 < 0 || x0 + width > out.width || y0 + height > out.height)
+        throw Error("postfilter: the output rectangle lies outside the image");
+    constexpr int kBand = 16;  // output rows a band (a simple partition: exactly this many, the last fewer)
+    tbb::enumerable_thread_specific<std::vector<glm::vec4>> buffers;
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, height, kBand),
+        [&](const tbb::blocked_range<int>& r) {
+            // Output row y reads sub-pixel rows k·(y + border) + first + j, j < n: the band's are
+            // `count` rows from s0, and row y's first is k·(y − r.begin()) of them.
+            const int s0 = k * (r.begin() + grid.border) + taps.first;
+            const int count = k * (r.end() - 1 - r.begin()) + n;
+            std::vector<glm::vec4>& rows = buffers.local();
+            if (rows.size() < size_t(count) * size_t(width)) rows.resize(size_t(count) * size_t(width));
+            for (int j = 0; j < count; ++j)
+                for (int x = 0; x < width; ++x) {
+                    const int first = k * (x + grid.border) + taps.first;
+                    glm::vec4 sum(0.f);
+                    for (int t = 0; t < n; ++t) sum += taps.weights[size_t(t)] * fine.at(first + t, s0 + j);
+                    rows[size_t(j) * size_t(width) + size_t(x)] = sum;
+                }
+            for (int y = r.begin(); y < r.end(); ++y) {
+                const size_t base = size_t(k) * size_t(y - r.begin());
+                for (int x = 0; x < width; ++x) {
+                    glm::vec4 sum(0.f);
+                    for (int t = 0; t < n; ++t) sum += taps.weights[size_t(t)] * rows[(base + size_t(t)) * size_t(width) + size_t(x)];
+                    out.at(x0 + x, y0 + y) = sum;
+                }
             }
-    });
-    // Vertical pass.
+        },
+        tbb::simple_partitioner());
+}
+}  // namespace
+
+void postfilterInto(const FrameView& fine, const SubpixelGrid& grid, int width, int height, Image& out, int x0, int y0) {
+    filterBands(fine, grid, width, height, out, x0, y0);
+}
+
+void postfilterInto(const Image& fine, const SubpixelGrid& grid, int width, int height, Image& out, int x0, int y0) {
+    filterBands(fine, grid, width, height, out, x0, y0);
+}
+
+Image postfilterImage(const Image& fine, const SubpixelGrid& grid, int width, int height) {
     Image out(width, height);
-    tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y < r.end(); ++y) {
-            const int s0 = k * (y + grid.border) + taps.first;
-            for (int x = 0; x < width; ++x) {
-                glm::vec4 sum(0.f);
-                for (int j = 0; j < n; ++j) sum += taps.weights[size_t(j)] * rows.at(x, s0 + j);
-                out.at(x, y) = sum;
-            }
-        }
-    });
+    postfilterInto(fine, grid, width, height, out, 0, 0);
     return out;
 }
 

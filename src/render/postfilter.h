@@ -55,4 +55,12 @@ PostfilterTaps postfilterTaps(const SubpixelGrid& grid);
 /// Separable, rows in parallel; the result does not depend on the thread count.
 Image postfilterImage(const Image& fine, const SubpixelGrid& grid, int width, int height);
 
+/// @brief postfilterImage's pixels written into @p out at (@p x0, @p y0), its other pixels left as
+/// they are, straight from the compositor's frame: a band of output rows at a time, each filtering
+/// the sub-pixel rows it reads into a buffer its thread keeps, so that no full-size intermediate
+/// (nor the copy into the final image) is made. The same sums in the same order as postfilterImage.
+/// @throw Error when @p fine or @p out do not match the grid and the rectangle.
+void postfilterInto(const FrameView& fine, const SubpixelGrid& grid, int width, int height, Image& out, int x0, int y0);
+void postfilterInto(const Image& fine, const SubpixelGrid& grid, int width, int height, Image& out, int x0, int y0);
+
 }  // namespace vdbsplat

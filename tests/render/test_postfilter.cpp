@@ -93,6 +93,44 @@ TEST(Postfilter, SeparableFilterMatchesBruteForce) {
     }
 }
 
+// Into a rectangle of a larger image, straight from a compositor's frame (radiance and T): the
+// rectangle holds brute force's pixels over several bands of rows (the last one short), the same
+// values as postfilterImage on the frame copied into an Image, and nothing else is written; a
+// rectangle outside the image is refused.
+TEST(Postfilter, IntoARectangleFromTheFrame) {
+    for (int k : {1, 2, 3}) {
+        const SubpixelGrid g = makeSubpixelGrid(k, kPrefilterVariance);
+        const int w = 23, h = 37, fw = k * (w + 2 * g.border), fh = k * (h + 2 * g.border);
+        const Image fine = randomImage(fw, fh, 31u + k);
+        std::vector<glm::vec3> color(fine.pixels.size());
+        std::vector<float> transmittance(fine.pixels.size());
+        Image asFrame(fw, fh);
+        for (size_t i = 0; i < fine.pixels.size(); ++i) {
+            color[i] = glm::vec3(fine.pixels[i]), transmittance[i] = 1.f - fine.pixels[i].w;
+            asFrame.pixels[i] = glm::vec4(color[i], 1.f - transmittance[i]);
+        }
+        const FrameView frame{color.data(), transmittance.data(), fw, fh};
+        const glm::vec4 sentinel(-7.f);
+        Image out(w + 9, h + 5);
+        for (auto& p : out.pixels) p = sentinel;
+        const int x0 = 6, y0 = 3;
+        postfilterInto(frame, g, w, h, out, x0, y0);
+        const Image whole = postfilterImage(asFrame, g, w, h), slow = bruteForce(asFrame, g, w, h);
+        for (int y = 0; y < out.height; ++y)
+            for (int x = 0; x < out.width; ++x) {
+                const bool inside = x >= x0 && x < x0 + w && y >= y0 && y < y0 + h;
+                if (!inside) {
+                    ASSERT_EQ(out.at(x, y), sentinel) << "k " << k << " pixel " << x << "," << y;
+                    continue;
+                }
+                ASSERT_EQ(out.at(x, y), whole.at(x - x0, y - y0)) << "k " << k << " pixel " << x << "," << y;
+                for (int c = 0; c < 4; ++c) ASSERT_NEAR(out.at(x, y)[c], slow.at(x - x0, y - y0)[c], 2e-6);
+            }
+        EXPECT_THROW(postfilterInto(frame, g, w, h, out, 10, 0), Error);
+        EXPECT_THROW(postfilterInto(frame, g, w + 1, h, out, 0, 0), Error);
+    }
+}
+
 TEST(Postfilter, KeepsConstantsAndEnergy) {
     const SubpixelGrid g = makeSubpixelGrid(2, kPrefilterVariance);
     const int w = 20, h = 20;
