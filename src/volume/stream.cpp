@@ -39,6 +39,11 @@ void VoxelBatch::resize(size_t n) {
     members.resize(n);
 }
 
+void VoxelBatch::reserve(size_t n, bool depthSpreads) {
+    viewPos.reserve(n), distance.reserve(n), sigma.reserve(n), color.reserve(n), spread.reserve(n), members.reserve(n);
+    if (depthSpreads) depthSpread.reserve(n);
+}
+
 void VoxelBatch::clear() {
     viewPos.clear();
     distance.clear();
@@ -668,6 +673,15 @@ void VoxelStream::release(size_t blocks, float limit, VoxelBatch& batch) {
 
 bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden) {
     batch.clear();
+    // Room for the largest windows at once: grown window by window, the batch and the pending
+    // records were copied at every growth and took fresh pages each time (a one-shot render's
+    // most page faults). Reserved, nothing is touched until written; by the records the blocks
+    // give, not their voxels (room for a far view's voxels is huge pages it would touch for few).
+    if (records_ == 0)
+        for (const Block& b : blocks_) records_ += recordsOf(b);
+    const size_t room = std::min<size_t>(records_, 2 * options_.maxWindowVoxels);
+    if (batch.viewPos.capacity() < room) batch.reserve(room, options_.depthSpread);
+    if (pending_.viewPos.capacity() < room) pending_.reserve(room, options_.depthSpread), pendingNext_.reserve(room, options_.depthSpread);
     while (true) {
         if (pending_.size() == 0) {
             if (nextBlock_ >= blocks_.size()) return false;

@@ -60,6 +60,7 @@ struct VoxelBatch {
     size_t size() const { return viewPos.size(); }
     void clear();           ///< empties every array, keeping their capacity
     void resize(size_t n);  ///< every array to @p n records
+    void reserve(size_t n, bool depthSpreads);  ///< room for @p n records in every array (no pages touched)
 };
 
 /// Level of detail: the largest spread an aggregate may add, as a fraction of the filter
@@ -217,6 +218,7 @@ private:
     std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
     std::vector<StreamCounts> blockCounts_;  // per activated block: its aggregates
     int64_t nextSlab_ = 0;
+    size_t records_ = 0;          // about how many records the blocks give (recordsOf), once known
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
     glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)
     // The voxel's shape in world units (volume/grid.h: any affine map): the largest semi-axis
