@@ -19,6 +19,7 @@
 #include "volume/leaf_extract.h"
 #include "volume/leaf_moments.h"
 #include "util/error.h"
+#include "util/fnv1a.h"
 #include "volume/emission.h"
 
 namespace vdbsplat {
@@ -83,6 +84,7 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
         diagonal = std::max(diagonal, glm::length(A * glm::dvec3(1.0, s & 1 ? -1.0 : 1.0, s & 2 ? -1.0 : 1.0)));
     blockHalfDiagonal_ = 0.5 * (kBlockDim - 1) * (volume_.isotropic ? std::sqrt(3.0) * volume_.voxelSize : diagonal);
     largestAxis_ = volume_.largestAxis();
+    if (options_.keepMoments && !shader_ && !emission_ && table_.entries()) moments_ = &(buffers ? buffers->moments : own_->moments);
     collectBlocks();
 }
 
@@ -91,7 +93,7 @@ void VoxelStream::collectBlocks() {
     std::vector<Block> all;
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
         if (leaf->onVoxelCount() == 0) continue;
-        all.push_back({leaf->origin(), kBlockDim, &*leaf, 0.f, 0.f, 0.f, uint32_t(leaf->onVoxelCount()), 0, 0.f});
+        all.push_back({leaf->origin(), kBlockDim, &*leaf, 0.f, 0.f, 0.f, uint32_t(leaf->onVoxelCount()), 0, 0.f, uint32_t(all.size())});
     }
     // Active tiles (values above leaf level): split into virtual 8³ blocks.
     auto it = tree.cbeginValueOn();
@@ -103,8 +105,9 @@ void VoxelStream::collectBlocks() {
             for (int y = box.min().y(); y <= box.max().y(); y += kBlockDim)
                 for (int z = box.min().z(); z <= box.max().z(); z += kBlockDim)
                     all.push_back({openvdb::Coord(x, y, z), kBlockDim, nullptr, *it, 0.f, 0.f,
-                                   uint32_t(kBlockDim * kBlockDim * kBlockDim), 0, 0.f});
+                                   uint32_t(kBlockDim * kBlockDim * kBlockDim), 0, 0.f, uint32_t(all.size())});
     }
+    if (moments_) prepareMomentCache(all.size());
     // Distance bounds of voxel centres (the block's bounding sphere around its centre), the frustum
     // test and the level of detail, block by block in parallel (each writes only its own block).
     const double halfDiagonal = blockHalfDiagonal_;
@@ -474,7 +477,51 @@ void forEachRow(const auto& b, const Volume& volume, const ClassificationTable& 
 // ≤ 3.5 voxels) so the float sums do not cancel, row by row: along a row of the block (z) the
 // offsets dx and dy are constant, so the row's Σσ, Σσ·dz and Σσ·dz² give every moment
 // (Σσ·dx·dz = dx·Σσ·dz, Σσ·dx² = dx²·Σσ, ...): three sums per voxel instead of ten.
+// The grid (its file, name, tree, voxel count and transform) and the baked table (its entries and
+// index map): what a block's moments depend on. A different grid or transfer function empties
+// the kept slots.
+void VoxelStream::prepareMomentCache(size_t blocks) {
+    LodMomentCache& cache = *moments_;
+    uint64_t key = fnv1a64(volume_.file.data(), volume_.file.size());
+    key = fnv1a64(volume_.name.data(), volume_.name.size(), key);
+    const uintptr_t tree = reinterpret_cast<uintptr_t>(&volume_.grid->tree());
+    const uint64_t counts[2] = {volume_.activeVoxels, blocks};
+    key = fnv1a64(&tree, sizeof tree, key);
+    key = fnv1a64(counts, sizeof counts, key);
+    key = fnv1a64(&volume_.indexToWorld, sizeof volume_.indexToWorld, key);
+    key = fnv1a64(table_.entries(), sizeof(Classified) * ClassificationTable::kSize, key);
+    const float map[2] = {table_.scale(), table_.offset()};
+    key = fnv1a64(map, sizeof map, key | 1);
+    if (cache.key == key && cache.blocks == blocks) return;
+    cache.key = key, cache.blocks = blocks;
+    cache.level1 = blocks * 64 * sizeof(CellMoments) <= LodMomentCache::kLevel1Budget;
+    for (int level = 1; level <= 3; ++level) {
+        const size_t cells = size_t(kBlockDim >> level) * size_t(kBlockDim >> level) * size_t(kBlockDim >> level);
+        const bool kept = level >= 2 || cache.level1;
+        std::remove_reference_t<decltype(cache.cells[0])>().swap(cache.cells[level - 1]);  // the old grid's slots go
+        cache.cells[level - 1].resize(kept ? blocks * cells : 0);
+        cache.have[level - 1].assign(kept ? blocks : 0, 0);
+    }
+}
+
+// Through the kept slots where there are (each block is extracted by one thread, so a slot is
+// written by one and read in a later render, after the parallel passes that separate them).
 void VoxelStream::cellMoments(const Block& b, int level, CellMoments* acc) const {
+    if (!moments_ || level < 1 || level > 3 || (level == 1 && !moments_->level1) || b.dim != kBlockDim)
+        return computeCellMoments(b, level, acc);
+    LodMomentCache& cache = *moments_;
+    const size_t cells = size_t(kBlockDim >> level) * size_t(kBlockDim >> level) * size_t(kBlockDim >> level);
+    CellMoments* slot = cache.cells[level - 1].data() + size_t(b.id) * cells;
+    uint8_t& have = cache.have[level - 1][b.id];
+    if (!have) {
+        std::fill_n(slot, cells, CellMoments{});  // the sums start from zero
+        computeCellMoments(b, level, slot);
+        have = 1;
+    }
+    std::copy_n(slot, cells, acc);
+}
+
+void VoxelStream::computeCellMoments(const Block& b, int level, CellMoments* acc) const {
     using Moments = CellMoments;
     const int side = 1 << level, cells = b.dim >> level;
     const float half = 0.5f * float(side - 1);

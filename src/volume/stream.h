@@ -130,6 +130,11 @@ struct StreamOptions {
     /// Plain leaves' voxels through the vectorised extraction (volume/leaf_extract.h); false: the
     /// voxel-by-voxel path it is tested against (the same records, bit for bit).
     bool vectorExtract = true;
+    /// Keep the level-of-detail moments in the buffers (StreamBuffers::moments) for the next render
+    /// of the same grid and table: set by renders that pass buffers kept between them (bench,
+    /// animate, study). Off for a single render, which would only fill it. Not with shading or
+    /// emission (their terms depend on the camera's eye).
+    bool keepMoments = false;
     /// Each record's depth spread (VoxelBatch::depthSpread) for the slab order's profiles; off,
     /// the array is left empty: 4 bytes less per voxel to write and move (the 10⁸ cloud's stream
     /// spent 0.3 s on it, session 6).
@@ -144,12 +149,31 @@ struct StreamCounts {
     uint64_t aggregatedVoxels = 0;  ///< active voxels they stand for (σ = 0 voxels excluded)
 };
 
+/// @brief Level-of-detail cell moments kept from one render to the next (StreamOptions::
+/// keepMoments: bench, animate, study). A block's moments depend on its voxels and the transfer
+/// function, not on the camera, so a far frame after the first need not classify its voxels
+/// again: the O(voxels) part of a far view. Keyed by the grid and the baked table (`key`); a
+/// block's cells at level 2 (4³ cells: 8 per block) and 3 (1), and at level 1 (64) where the
+/// grid's blocks fit kLevel1Budget. Each slot holds exactly what VoxelStream computes for it, so
+/// an image never depends on whether it came from here.
+struct LodMomentCache {
+    static constexpr size_t kLevel1Budget = size_t(64) << 20;  ///< bytes for the level-1 cells, at most
+    uint64_t key = 0;        ///< the grid and table the slots belong to (0: none yet)
+    size_t blocks = 0;       ///< block ids (VoxelStream::Block::id) the slots are for
+    bool level1 = false;     ///< level 1 kept (the blocks fit the budget)
+    /// per level 1–3: cells of block id at id·(8 >> level)³; not initialised (a slot is zeroed when
+    /// it is filled), so only the blocks a render draws at a level touch their pages
+    std::vector<CellMoments, HugePageAllocator<CellMoments>> cells[3];
+    std::vector<uint8_t> have[3];       ///< per level and block id: the slot is filled
+};
+
 /// @brief The stream's voxel buffers. A caller rendering many images keeps them from one render
 /// to the next (render/hybrid.h, ForwardBuffers): they grow, never shrink, and are emptied or
 /// rewritten before use, so a render never depends on what they held.
 struct StreamBuffers {
     VoxelBatch pending, pendingNext;
     std::vector<VoxelBatch> extracted;
+    LodMomentCache moments;  ///< only with StreamOptions::keepMoments
 };
 
 class VoxelStream {
@@ -187,6 +211,7 @@ private:
         uint32_t voxels;                // active voxels
         int lodLevel;                   // 0: voxel by voxel; L ≥ 1: aggregates of (2^L)³ cells
         float lodFine;                  // blended: 1 − t, t the passage to lodLevel from lodLevel − 1 (0: lodLevel alone)
+        uint32_t id;                    // its place in the grid's leaf-then-tile order (the same every render)
     };
     void collectBlocks();
     bool visible(const Block& b) const;
@@ -196,6 +221,8 @@ private:
     void extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const;  // counts: aggregates only
     void extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const;
     void cellMoments(const Block& b, int level, CellMoments* acc) const;
+    void computeCellMoments(const Block& b, int level, CellMoments* acc) const;
+    void prepareMomentCache(size_t blocks);  // keys (or empties) the kept moments for this grid and table
     void emitCells(const Block& b, int level, const CellMoments* acc, const float* coarse, bool fineSide,
                    VoxelBatch& out, StreamCounts& counts) const;
     template <typename Keep, typename Fn> void forEachActive(const Block& b, Keep&& keep, Fn&& fn) const;
@@ -217,6 +244,7 @@ private:
     std::vector<VoxelBatch>& extracted_;  // per activated block of the window (reused)
     std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
     std::vector<StreamCounts> blockCounts_;  // per activated block: its aggregates
+    LodMomentCache* moments_ = nullptr;  // kept moments (StreamOptions::keepMoments), or null
     int64_t nextSlab_ = 0;
     size_t records_ = 0;          // about how many records the blocks give (recordsOf), once known
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)

@@ -305,6 +305,66 @@ TEST(Stream, FarWindowsAreSizedByRecords) {
     EXPECT_LE(windows, 3u) << records << " records";  // by voxels: 6
 }
 
+// Kept level-of-detail moments (StreamOptions::keepMoments, LodMomentCache): a second render with
+// the same buffers reads the moments its first one kept, and gives the same records bit for bit
+// as a stream that keeps none; the slots are really read (spoiled, the records change); and
+// another transfer function empties them (the records are that table's, not the spoiled slots').
+namespace {
+struct Records {
+    std::vector<float> values;  // every record's fields in order
+    bool operator==(const Records&) const = default;
+};
+Records streamRecords(const Volume& v, const Camera& camera, const ClassificationTable& table, StreamBuffers* kept) {
+    StreamOptions o;
+    o.pointBelowPx = 1.0;
+    o.lodCellPx = 1.25;
+    o.keepMoments = kept != nullptr;
+    VoxelStream stream(v, camera, table, o, nullptr, nullptr, kept);
+    VoxelBatch batch;
+    Records r;
+    while (stream.next(batch))
+        for (size_t i = 0; i < batch.size(); ++i)
+            r.values.insert(r.values.end(), {batch.viewPos[i].x, batch.viewPos[i].y, batch.viewPos[i].z, batch.sigma[i],
+                                             batch.color[i].x, batch.color[i].y, batch.color[i].z, batch.spread[i],
+                                             float(batch.members[i])});
+    return r;
+}
+ClassificationTable rampTable(float slope) {
+    std::vector<Classified> entries(ClassificationTable::kSize);
+    for (int i = 0; i < ClassificationTable::kSize; ++i) {
+        const float t = float(i) / float(ClassificationTable::kSize - 1);
+        entries[size_t(i)] = {glm::vec3(t, 1.f - t, 0.5f), t < 0.2f ? 0.f : slope * t};
+    }
+    return ClassificationTable(entries, 0.f, 1.f);
+}
+}  // namespace
+
+TEST(Stream, KeptMomentsAreReadAndFollowTheTable) {
+    const Volume& v = cloud();
+    const ClassificationTable a = rampTable(0.3f), b = rampTable(0.7f);
+    StreamBuffers kept;
+    for (const double distance : {8.0, 3.0}) {  // 4³ and 8³ cells, then 2³ cells blended
+        SCOPED_TRACE("distance " + std::to_string(distance));
+        const Camera camera = framedCamera(v, 256, distance);
+        const Records fresh = streamRecords(v, camera, a, nullptr);
+        size_t aggregates = 0;
+        for (size_t i = 8; i < fresh.values.size(); i += 9) aggregates += fresh.values[i] > 1.f ? 1 : 0;
+        ASSERT_GT(aggregates, 100u);  // level of detail at work
+        EXPECT_EQ(streamRecords(v, camera, a, &kept), fresh);  // fills the slots (or reads them)
+        EXPECT_EQ(streamRecords(v, camera, a, &kept), fresh);  // reads them
+    }
+    size_t filled = 0;
+    for (int level = 0; level < 3; ++level)
+        for (uint8_t h : kept.moments.have[level]) filled += h;
+    ASSERT_GT(filled, 100u);
+    for (auto& cells : kept.moments.cells)
+        for (CellMoments& c : cells) c.m *= 2.f, c.emission *= 2.f;  // spoiled: twice the mass
+    const Camera far = framedCamera(v, 256, 8.0);
+    EXPECT_NE(streamRecords(v, far, a, &kept), streamRecords(v, far, a, nullptr));
+    EXPECT_EQ(streamRecords(v, far, b, &kept), streamRecords(v, far, b, nullptr));  // another table: emptied
+    EXPECT_EQ(streamRecords(v, far, b, &kept), streamRecords(v, far, b, nullptr));
+}
+
 // Blended levels (StreamOptions::lodBlend): along a zoom through every level change the leaves
 // are drawn at two neighbouring levels with their optical depth split between them, so the
 // records' total mass Σσ is the voxels' at every camera (energy, DESIGN §8.2) and each voxel is
