@@ -491,7 +491,9 @@ void VoxelStream::prepareMomentCache(size_t blocks) {
     key = fnv1a64(&volume_.indexToWorld, sizeof volume_.indexToWorld, key);
     key = fnv1a64(table_.entries(), sizeof(Classified) * ClassificationTable::kSize, key);
     const float map[2] = {table_.scale(), table_.offset()};
-    key = fnv1a64(map, sizeof map, key | 1);
+    key = fnv1a64(map, sizeof map, key);
+    const uint8_t path = options_.vectorLeafMoments ? 1 : 0;  // the vector and the scalar sums round apart
+    key = fnv1a64(&path, sizeof path, key) | 1;  // never 0 (none yet)
     if (cache.key == key && cache.blocks == blocks) return;
     cache.key = key, cache.blocks = blocks;
     cache.level1 = blocks * 64 * sizeof(CellMoments) <= LodMomentCache::kLevel1Budget;
