@@ -630,12 +630,12 @@ void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, c
 // A block's records, about: its voxels, or its cells at a level of detail (both levels' when
 // blended). Windows are sized by records, the work downstream: sized by voxels, a far view's
 // windows held a few thousand records each, and their fixed costs (a dozen parallel passes
-// each) outweighed their work.
-// Nor more than kMaxWindowBlocks blocks a window (while it grows past its slabs): each keeps
-// its own buffer (extracted_), and a one-shot render pays for every fresh one.
+// each) outweighed their work. A window still takes at most kMaxWindowBlocks blocks while it
+// grows past its slabs: each block keeps its own buffer (extracted_), and a one-shot render
+// pays for every fresh one.
 size_t VoxelStream::recordsOf(const Block& b) {
     if (b.lodLevel == 0) return b.voxels;
-    const size_t cells = size_t(1) << (3 * (kBlockDim == 8 ? 3 - b.lodLevel : 0));  // (8 >> ℓ)³
+    const size_t side = size_t(kBlockDim >> b.lodLevel), cells = side * side * side;
     const size_t atLevel = std::min<size_t>(b.voxels, cells);
     return b.lodFine > 0.f ? std::min<size_t>(b.voxels, 9 * atLevel) : atLevel;  // the finer level: 8× the cells
 }
