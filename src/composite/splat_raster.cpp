@@ -66,7 +66,17 @@ HWY_INLINE V Tau(D d, const SplatRaster& s, V dx, V dy, V i2, M& mask) {
     return TauAt(d, s, t);
 }
 
-/// α = 1 − e^{−τ} for τ ≥ 0. A vector whose lanes all have τ < 1/2 takes the Taylor series to τ⁸
+/// 1 − e^{−τ} ≈ τ·Σ_{k<K} (−τ)^k/(k + 1)!, the Taylor series to τ^K (Horner: K − 1 FMAs and a product).
+template <int K, class D, class V = hn::Vec<D>>
+HWY_INLINE V OpacitySeriesTo(D d, V tau) {
+    static_assert(K >= 1 && K <= 8);
+    constexpr float c[8] = {1.f, -0.5f, 1.f / 6.f, -1.f / 24.f, 1.f / 120.f, -1.f / 720.f, 1.f / 5040.f, -1.f / 40320.f};
+    V p = hn::Set(d, c[K - 1]);
+    for (int k = K - 2; k >= 0; --k) p = hn::MulAdd(p, tau, hn::Set(d, c[k]));
+    return hn::Mul(p, tau);
+}
+
+/// α = 1 − e^{−τ} for τ ≥ 0, the splat's series (OpacitySeries) or, for Any: A vector whose lanes all have τ < 1/2 takes the Taylor series to τ⁸
 /// (Horner, 7 FMAs and a product): its truncation error is below τ⁹/9!, i.e. below 1.4e−8·α for
 /// every τ < 1/2 (α > 0.39·2τ there), under float rounding, and it has no cancellation for
 /// small τ. Any other vector takes Highway's Expm1 (≈ 30 operations: a fifth of the framed
@@ -75,33 +85,9 @@ HWY_INLINE V Tau(D d, const SplatRaster& s, V dx, V dy, V i2, M& mask) {
 template <class D, class V = hn::Vec<D>>
 HWY_INLINE V OpacityFromTau(D d, V tau, OpacitySeries series = OpacitySeries::Any) {
     // A splat whose every τ is small (opacitySeriesFor): a shorter series, no test per vector.
-    if (series == OpacitySeries::Degree4) {
-        V p = hn::Set(d, -1.f / 24.f);
-        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 6.f));
-        p = hn::MulAdd(p, tau, hn::Set(d, -0.5f));
-        p = hn::MulAdd(p, tau, hn::Set(d, 1.f));
-        return hn::Mul(p, tau);
-    }
-    if (series == OpacitySeries::Degree6) {
-        V p = hn::Set(d, -1.f / 720.f);
-        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 120.f));
-        p = hn::MulAdd(p, tau, hn::Set(d, -1.f / 24.f));
-        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 6.f));
-        p = hn::MulAdd(p, tau, hn::Set(d, -0.5f));
-        p = hn::MulAdd(p, tau, hn::Set(d, 1.f));
-        return hn::Mul(p, tau);
-    }
-    if (hn::AllTrue(d, hn::Lt(tau, hn::Set(d, 0.5f)))) {
-        V p = hn::Set(d, -1.f / 40320.f);
-        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 5040.f));
-        p = hn::MulAdd(p, tau, hn::Set(d, -1.f / 720.f));
-        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 120.f));
-        p = hn::MulAdd(p, tau, hn::Set(d, -1.f / 24.f));
-        p = hn::MulAdd(p, tau, hn::Set(d, 1.f / 6.f));
-        p = hn::MulAdd(p, tau, hn::Set(d, -0.5f));
-        p = hn::MulAdd(p, tau, hn::Set(d, 1.f));
-        return hn::Mul(p, tau);
-    }
+    if (series == OpacitySeries::Degree4) return OpacitySeriesTo<4>(d, tau);
+    if (series == OpacitySeries::Degree6) return OpacitySeriesTo<6>(d, tau);
+    if (hn::AllTrue(d, hn::Lt(tau, hn::Set(d, 0.5f)))) return OpacitySeriesTo<8>(d, tau);
     return hn::Neg(hn::Expm1(d, hn::Neg(tau)));  // 1 − e^{−τ}
 }
 

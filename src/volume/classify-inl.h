@@ -19,6 +19,18 @@ HWY_BEFORE_NAMESPACE();
 namespace vdbsplat {
 namespace HWY_NAMESPACE {
 
+/// Vectors of whole 8-voxel rows (8 or 16 float lanes): each lane keeps its z from one vector to
+/// the next. The leaf passes run on such targets only; others take the scalar paths.
+template <class D>
+constexpr bool kWholeRows = hwy::HWY_NAMESPACE::MaxLanes(D()) == 8 || hwy::HWY_NAMESPACE::MaxLanes(D()) == 16;
+
+/// True when the target's vectors of @p D hold whole rows (as kWholeRows, and fully used).
+template <class D>
+bool WholeRowsSupported(D) {
+    if constexpr (kWholeRows<D>) return hwy::HWY_NAMESPACE::Lanes(D()) == hwy::HWY_NAMESPACE::MaxLanes(D());
+    return false;
+}
+
 #if HWY_TARGET != HWY_SCALAR
 /// The baked table's constants as vectors, set up once per leaf; @p table must not be empty().
 template <class D>

@@ -15,17 +15,7 @@ namespace vdbsplat {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-/// Whole rows per vector (8 or 16 float lanes), as the level-of-detail sums.
-template <class D>
-constexpr bool kRows = hn::MaxLanes(D()) == 8 || hn::MaxLanes(D()) == 16;
-
-template <class D>
-bool Supported(D) {
-    if constexpr (kRows<D>) return hn::Lanes(D()) == hn::MaxLanes(D());
-    return false;
-}
-
-bool LeafExtractSupported() { return Supported(hn::ScalableTag<float>()); }
+bool LeafExtractSupported() { return WholeRowsSupported(hn::ScalableTag<float>()); }
 
 /// The records of one leaf, a vector of rows at a time. The view position splits as glm computes
 /// it, v = (m₀X + m₁Y) + (m₂Z + m₃): the second sum depends on z alone, so it is one vector per
@@ -35,7 +25,7 @@ template <class D>
 size_t ExtractRows(D d, const float* values, const uint64_t* maskWords, const ClassificationTable& table,
                    const glm::dmat4& M, const glm::ivec3& origin, const LeafRecords& out) {
 #if HWY_TARGET != HWY_SCALAR
-    if constexpr (kRows<D>) {
+    if constexpr (kWholeRows<D>) {
         using V = hn::Vec<D>;
         const hn::Repartition<double, D> dd;     // half the lanes, in double
         using VD = hn::Vec<decltype(dd)>;

@@ -17,18 +17,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 constexpr int kLeafSide = 8;
 
-/// Whole rows per vector (8 or 16 lanes): every lane keeps its z, so its cell along z, from one
-/// vector to the next. Narrower or wider targets take the scalar sums (leafMomentsSupported).
-template <class D>
-constexpr bool kRowLanes = hn::MaxLanes(D()) == 8 || hn::MaxLanes(D()) == 16;
-
-template <class D>
-bool Supported(D) {
-    if constexpr (kRowLanes<D>) return hn::Lanes(D()) == hn::MaxLanes(D());
-    return false;
-}
-
-bool LeafMomentsSupported() { return Supported(hn::ScalableTag<float>()); }
+bool LeafMomentsSupported() { return WholeRowsSupported(hn::ScalableTag<float>()); }
 
 #if HWY_TARGET != HWY_SCALAR
 /// A vector of whole 8-voxel rows folded onto one row: lane z of the result is the sum of lane z of
@@ -50,8 +39,8 @@ auto FoldRows(D d, hn::Vec<D> v) {
 template <class D>
 void RowMoments(D d, const float* values, const uint64_t* maskWords, const ClassificationTable& table, int level,
                 CellMoments* out) {
-#if HWY_TARGET != HWY_SCALAR  // one lane: no halves or lane pairs to name (and kRowLanes is false)
-    if constexpr (kRowLanes<D>) {
+#if HWY_TARGET != HWY_SCALAR  // one lane: no halves or lane pairs to name (and kWholeRows is false)
+    if constexpr (kWholeRows<D>) {
         const hn::RebindToSigned<decltype(d)> di;
         using V = hn::Vec<decltype(d)>;
         const int lanes = int(hn::Lanes(d)), rowsPerVector = lanes / kLeafSide;

@@ -378,46 +378,19 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
     out.withDepthSpread = options_.depthSpread;
     out.resize(first + std::min<size_t>(b.voxels, openvdb::FloatTree::LeafNodeType::SIZE));
     size_t k = first;
-    if (!coarse && b.leaf && !shader_ && !emission_) {  // the plain case, word by word of the value mask
-        const float* values = b.leaf->buffer().data();
+    // A plain leaf (no shading, emission or blend weights): a vector of rows at a time
+    // (volume/leaf_extract.h), the same records as the voxel-by-voxel path below.
+    if (!coarse && b.leaf && !shader_ && !emission_ && options_.vectorExtract && table_.entries() && leafExtractSupported()) {
         const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE;
-        if (options_.vectorExtract && table_.entries() && leafExtractSupported()) {  // a vector of rows at a time
-            std::array<uint64_t, 8> words;
-            for (int x = 0; x < 8; ++x) words[size_t(x)] = b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));
-            const LeafRecords to{out.viewPos.data() + first, out.distance.data() + first, out.sigma.data() + first,
-                                 out.color.data() + first};
-            k += extractLeafVoxels(values, dense ? nullptr : words.data(), table_, indexToView_,
-                                   glm::ivec3(b.origin.x(), b.origin.y(), b.origin.z()), to);
-            std::fill(out.spread.begin() + ptrdiff_t(first), out.spread.begin() + ptrdiff_t(k), 0.f);
-            if (options_.depthSpread) std::fill(out.depthSpread.begin() + ptrdiff_t(first), out.depthSpread.begin() + ptrdiff_t(k), 0.f);
-            std::fill(out.members.begin() + ptrdiff_t(first), out.members.begin() + ptrdiff_t(k), 1u);
-            out.resize(k);
-            return;
-        }
-        const auto& M = indexToView_;
-        for (int x = 0; x < kBlockDim; ++x) {
-            uint64_t word = dense ? ~uint64_t(0) : b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));
-            const double X = origin.x + double(x);
-            // glm's dmat4 · dvec4: (m0·X + m1·Y) + (m2·Z + m3·1), each term rounded, as below.
-            const glm::dvec3 mx = glm::dvec3(M[0]) * X;
-            while (word != 0) {
-                const int yz = std::countr_zero(word);
-                word &= word - 1;
-                const openvdb::Index n = openvdb::Index((x << 6) | yz);
-                const Classified cls = table_(values[n]);
-                if (!(cls.sigma > 0.f)) continue;
-                const glm::dvec3 v = (mx + glm::dvec3(M[1]) * (origin.y + double(yz >> 3))) +
-                                     (glm::dvec3(M[2]) * (origin.z + double(yz & 7)) + glm::dvec3(M[3]));
-                out.viewPos[k] = glm::vec3(v);
-                out.distance[k] = float(glm::length(v));
-                out.sigma[k] = cls.sigma;
-                out.color[k] = cls.color;
-                out.spread[k] = 0.f;
-                if (options_.depthSpread) out.depthSpread[k] = 0.f;
-                out.members[k] = 1;
-                ++k;
-            }
-        }
+        std::array<uint64_t, 8> words;
+        for (int x = 0; x < 8; ++x) words[size_t(x)] = b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));
+        const LeafRecords to{out.viewPos.data() + first, out.distance.data() + first, out.sigma.data() + first,
+                             out.color.data() + first};
+        k += extractLeafVoxels(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, indexToView_,
+                               glm::ivec3(b.origin.x(), b.origin.y(), b.origin.z()), to);
+        std::fill(out.spread.begin() + ptrdiff_t(first), out.spread.begin() + ptrdiff_t(k), 0.f);
+        if (options_.depthSpread) std::fill(out.depthSpread.begin() + ptrdiff_t(first), out.depthSpread.begin() + ptrdiff_t(k), 0.f);
+        std::fill(out.members.begin() + ptrdiff_t(first), out.members.begin() + ptrdiff_t(k), 1u);
         out.resize(k);
         return;
     }

@@ -453,24 +453,28 @@ namespace {
 // NaN and infinity (σ = 0, not counted), and a colour-varying table.
 void expectLeafMomentsMatchTheSums();
 
-// On the widest vectors this CPU has, and again on AVX2 (8 lanes: one row per vector, lane pairs
-// of 4 doubles) where the CPU has wider ones, so that both row layouts are tested here.
-TEST(LeafMoments, MatchTheSumsVoxelByVoxel) {
-    if (!leafMomentsSupported()) GTEST_SKIP() << "this CPU's vectors do not hold whole 8-voxel rows (scalar sums only)";
+/// Runs @p body on the widest target this CPU has, and again on AVX2 (8 lanes: one row per
+/// vector, lane pairs of 4 doubles) where the CPU has wider ones, so that both row layouts of the
+/// whole-leaf passes are tested here; @p supported says whether the pass runs on a target.
+template <class Supported, class Body>
+void onBestAndAvx2(Supported supported, Body body) {
+    if (!supported()) GTEST_SKIP() << "this CPU's vectors do not hold whole 8-voxel rows (scalar path only)";
     {
         SCOPED_TRACE("best target");
-        expectLeafMomentsMatchTheSums();
+        body();
     }
 #if HWY_ARCH_X86
     if ((hwy::SupportedTargets() & HWY_AVX2) && hwy::SupportedTargets() != HWY_AVX2) {
         hwy::SetSupportedTargetsForTest(HWY_AVX2);
-        ASSERT_TRUE(leafMomentsSupported());
+        ASSERT_TRUE(supported());
         SCOPED_TRACE("AVX2");
-        expectLeafMomentsMatchTheSums();
+        body();
         hwy::SetSupportedTargetsForTest(0);  // back to what the CPU has
     }
 #endif
 }
+
+TEST(LeafMoments, MatchTheSumsVoxelByVoxel) { onBestAndAvx2(leafMomentsSupported, expectLeafMomentsMatchTheSums); }
 
 void expectLeafMomentsMatchTheSums() {
     std::vector<Classified> entries(ClassificationTable::kSize);
@@ -534,21 +538,30 @@ void expectLeafMomentsMatchTheSums() {
 // camera off every axis; on the widest target and on AVX2 (one row per vector) where wider exist.
 void expectLeafExtractionMatchesTheVoxels();
 
-TEST(LeafExtract, EqualsTheVoxelByVoxelRecords) {
+TEST(LeafExtract, EqualsTheVoxelByVoxelRecords) { onBestAndAvx2(leafExtractSupported, expectLeafExtractionMatchesTheVoxels); }
+
+// In the stream: the same records, window by window, with the vectorised extraction as with the
+// voxel-by-voxel path (StreamOptions::vectorExtract), at a framed view where every block is voxels.
+TEST(LeafExtract, StreamRecordsEqualTheVoxelByVoxelPath) {
     if (!leafExtractSupported()) GTEST_SKIP() << "this CPU's vectors do not hold whole 8-voxel rows (scalar path only)";
-    {
-        SCOPED_TRACE("best target");
-        expectLeafExtractionMatchesTheVoxels();
+    const Volume& v = cloud();
+    const Camera camera = framedCamera(v, 256, 1.0);
+    const ClassificationTable table = constantTable(0.05f);
+    std::vector<std::vector<float>> runs;
+    for (const bool vector : {true, false}) {
+        StreamOptions o;
+        o.vectorExtract = vector;
+        VoxelStream stream(v, camera, table, o);
+        VoxelBatch batch;
+        std::vector<float> r;
+        while (stream.next(batch))
+            for (size_t i = 0; i < batch.size(); ++i)
+                r.insert(r.end(), {batch.viewPos[i].x, batch.viewPos[i].y, batch.viewPos[i].z, batch.distance[i],
+                                   batch.sigma[i], batch.color[i].x, float(batch.members[i])});
+        runs.push_back(std::move(r));
     }
-#if HWY_ARCH_X86
-    if ((hwy::SupportedTargets() & HWY_AVX2) && hwy::SupportedTargets() != HWY_AVX2) {
-        hwy::SetSupportedTargetsForTest(HWY_AVX2);
-        ASSERT_TRUE(leafExtractSupported());
-        SCOPED_TRACE("AVX2");
-        expectLeafExtractionMatchesTheVoxels();
-        hwy::SetSupportedTargetsForTest(0);  // back to what the CPU has
-    }
-#endif
+    ASSERT_GT(runs[0].size(), 7 * size_t(100000));
+    EXPECT_EQ(runs[0], runs[1]);
 }
 
 void expectLeafExtractionMatchesTheVoxels() {
