@@ -90,11 +90,21 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
 
 void VoxelStream::collectBlocks() {
     const auto& tree = volume_.grid->tree();
+    // The leaves from the internal nodes' tables (the leaf iterator's order), their voxel counts in
+    // parallel: each count reads a leaf's mask for the first time since the load, and the iterator
+    // walked them one dependent miss after another (0.5 ms of the far Engine's 10).
+    std::vector<const openvdb::FloatTree::LeafNodeType*> leaves;
+    leaves.reserve(tree.leafCount());
+    tree.getNodes(leaves);
+    std::vector<uint32_t> onVoxels(leaves.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) onVoxels[i] = uint32_t(leaves[i]->onVoxelCount());
+    });
     std::vector<Block> all;
-    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
-        if (leaf->onVoxelCount() == 0) continue;
-        all.push_back({leaf->origin(), kBlockDim, &*leaf, 0.f, 0.f, 0.f, uint32_t(leaf->onVoxelCount()), 0, 0.f, uint32_t(all.size())});
-    }
+    all.reserve(leaves.size());
+    for (size_t i = 0; i < leaves.size(); ++i)
+        if (onVoxels[i] != 0)
+            all.push_back({leaves[i]->origin(), kBlockDim, leaves[i], 0.f, 0.f, 0.f, onVoxels[i], 0, 0.f, uint32_t(all.size())});
     // Active tiles (values above leaf level): split into virtual 8³ blocks.
     auto it = tree.cbeginValueOn();
     it.setMaxDepth(it.getLeafDepth() - 1);
