@@ -241,7 +241,8 @@ private:
     std::unique_ptr<StreamBuffers> own_;  // the buffers, unless the caller keeps them
     VoxelBatch& pending_;         // voxels of activated blocks not yet released
     VoxelBatch& pendingNext_;     // the pending voxels a window keeps (swapped with pending_)
-    std::vector<VoxelBatch>& extracted_;  // per activated block of the window (reused)
+    std::vector<VoxelBatch>& extracted_;  // per chunk of kExtractChunk activated blocks of the window (reused)
+    std::vector<std::pair<size_t, size_t>> blockRecords_;  // per activated block: its records in its chunk's buffer
     std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
     std::vector<StreamCounts> blockCounts_;  // per activated block: its aggregates
     LodMomentCache* moments_ = nullptr;  // kept moments (StreamOptions::keepMoments), or null
