@@ -616,7 +616,7 @@ void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, c
 // windows held a few thousand records each, and their fixed costs (a dozen parallel passes
 // each) outweighed their work. A window still takes at most kMaxWindowBlocks blocks while it
 // grows past its slabs: with the blocks' records in one buffer per kExtractChunk blocks (session
-// 14), 256–4 096 blocks measured within noise of 512 on the far views, 4 096 up to 14 % slower.
+// 14), 128 and 256 blocks measured within noise of 512 on the far views, 4 096 up to 14 % slower.
 size_t VoxelStream::recordsOf(const Block& b) {
     if (b.lodLevel == 0) return b.voxels;
     const size_t side = size_t(kBlockDim >> b.lodLevel), cells = side * side * side;
@@ -733,7 +733,7 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                 slabEnd = int64_t(std::floor(blocks_[nextBlock_].dMin / slabLength_)) + slabsPerWindow_;
         }
         // Activate the blocks whose front the window reached: extract them in parallel, in order.
-        // The per-block buffers are reused window after window (no allocation once warm).
+        // The chunks' buffers are reused window after window (no allocation once warm).
         const size_t count = nextBlock_ - first, chunks = (count + kExtractChunk - 1) / kExtractChunk;
         if (extracted_.size() < chunks) extracted_.resize(chunks);
         skipped_.assign(count, 0);

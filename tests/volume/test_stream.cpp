@@ -500,26 +500,43 @@ void onBestAndAvx2(Supported supported, Body body) {
 #endif
 }
 
-TEST(LeafMoments, MatchTheSumsVoxelByVoxel) { onBestAndAvx2(leafMomentsSupported, expectLeafMomentsMatchTheSums); }
-
-void expectLeafMomentsMatchTheSums() {
+/// A ramp over the classification table (values mapped from [−0.5, 2]): colour (t, 1 − t,
+/// 0.3 + 0.4t²), σ = 0 below @p clearBelow, else 0.02 + 2t.
+ClassificationTable leafTestTable(float clearBelow) {
     std::vector<Classified> entries(ClassificationTable::kSize);
     for (int i = 0; i < ClassificationTable::kSize; ++i) {
         const float t = float(i) / float(ClassificationTable::kSize - 1);
-        entries[size_t(i)] = {glm::vec3(t, 1.f - t, 0.3f + 0.4f * t * t), t < 0.1f ? 0.f : 0.02f + 2.f * t};
+        entries[size_t(i)] = {glm::vec3(t, 1.f - t, 0.3f + 0.4f * t * t), t < clearBelow ? 0.f : 0.02f + 2.f * t};
     }
-    const ClassificationTable table(entries, -0.5f, 2.f);
-    uint32_t state = 99;
+    return ClassificationTable(entries, -0.5f, 2.f);
+}
+
+/// One random 8³ leaf: values in [−1, 3), a NaN and an @p infinity at places that move with
+/// @p trial, each voxel active with probability @p activeShare (the mask words); @p state is the
+/// generator's, carried from leaf to leaf.
+struct RandomLeaf {
+    std::array<float, 512> values;
+    std::array<uint64_t, 8> words{};
+};
+RandomLeaf randomLeaf(int trial, uint32_t& state, float infinity, float activeShare) {
     const auto rnd = [&] { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1 << 24); };
+    RandomLeaf leaf;
+    for (int n = 0; n < 512; ++n) {
+        leaf.values[size_t(n)] = -1.f + 4.f * rnd();
+        if (n % 97 == trial % 97) leaf.values[size_t(n)] = std::numeric_limits<float>::quiet_NaN();
+        if (n % 89 == trial % 89) leaf.values[size_t(n)] = infinity;
+        if (rnd() < activeShare) leaf.words[size_t(n >> 6)] |= uint64_t(1) << (n & 63);
+    }
+    return leaf;
+}
+
+TEST(LeafMoments, MatchTheSumsVoxelByVoxel) { onBestAndAvx2(leafMomentsSupported, expectLeafMomentsMatchTheSums); }
+
+void expectLeafMomentsMatchTheSums() {
+    const ClassificationTable table = leafTestTable(0.1f);
+    uint32_t state = 99;
     for (int trial = 0; trial < 40; ++trial) {
-        std::array<float, 512> values;
-        std::array<uint64_t, 8> words{};
-        for (int n = 0; n < 512; ++n) {
-            values[size_t(n)] = -1.f + 4.f * rnd();
-            if (n % 97 == trial % 97) values[size_t(n)] = std::numeric_limits<float>::quiet_NaN();
-            if (n % 89 == trial % 89) values[size_t(n)] = -std::numeric_limits<float>::infinity();
-            if (rnd() < 0.7f) words[size_t(n >> 6)] |= uint64_t(1) << (n & 63);
-        }
+        const auto [values, words] = randomLeaf(trial, state, -std::numeric_limits<float>::infinity(), 0.7f);
         const bool dense = trial % 4 == 0;
         const int level = 1 + trial % 3, side = 1 << level, cells = 8 >> level;
         const float half = 0.5f * float(side - 1);
@@ -591,12 +608,7 @@ TEST(LeafExtract, StreamRecordsEqualTheVoxelByVoxelPath) {
 }
 
 void expectLeafExtractionMatchesTheVoxels() {
-    std::vector<Classified> entries(ClassificationTable::kSize);
-    for (int i = 0; i < ClassificationTable::kSize; ++i) {
-        const float t = float(i) / float(ClassificationTable::kSize - 1);
-        entries[size_t(i)] = {glm::vec3(t, 1.f - t, 0.3f + 0.4f * t * t), t < 0.3f ? 0.f : 0.02f + 2.f * t};
-    }
-    const ClassificationTable table(entries, -0.5f, 2.f);
+    const ClassificationTable table = leafTestTable(0.3f);
     // An index-to-view transform off every axis, with a translation and an uneven scale (as
     // VoxelStream's worldToView · indexToWorld; any affine map).
     glm::dmat4 indexToView(1.0);
@@ -605,17 +617,9 @@ void expectLeafExtractionMatchesTheVoxels() {
         for (int r = 0; r < 3; ++r) indexToView[c][r] = m[c * 3 + r] * (0.37 + 0.01 * c);
     indexToView[3] = glm::dvec4(m[9], m[10], m[11], 1.0);
     uint32_t state = 5;
-    const auto rnd = [&] { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1 << 24); };
     size_t kept = 0;
     for (int trial = 0; trial < 40; ++trial) {
-        std::array<float, 512> values;
-        std::array<uint64_t, 8> words{};
-        for (int n = 0; n < 512; ++n) {
-            values[size_t(n)] = -1.f + 4.f * rnd();
-            if (n % 97 == trial % 97) values[size_t(n)] = std::numeric_limits<float>::quiet_NaN();
-            if (n % 89 == trial % 89) values[size_t(n)] = std::numeric_limits<float>::infinity();
-            if (rnd() < 0.6f) words[size_t(n >> 6)] |= uint64_t(1) << (n & 63);
-        }
+        auto [values, words] = randomLeaf(trial, state, std::numeric_limits<float>::infinity(), 0.6f);
         if (trial % 5 == 1) std::fill(values.begin(), values.begin() + 192, 0.1f);  // transparent rows
         const bool dense = trial % 4 == 0;
         const glm::ivec3 origin(8 * (trial % 3) - 8, 8 * (trial % 5), -16 + 8 * (trial % 7));
