@@ -15,6 +15,7 @@
 #include "composite/opacity.h"
 #include "composite/point_raster.h"
 #include "composite/splat_raster.h"
+#include "composite/tile_sort.h"
 #include "footprint/kernel.h"
 
 namespace vdbsplat {
@@ -62,32 +63,6 @@ struct ChunkRange {
     uint32_t depthLo = std::numeric_limits<uint32_t>::max(), depthHi = 0;
 };
 
-/// Stable LSD radix sort of the @p n 64-bit entries at @p a by their bits [@p low, @p low + @p bits),
-/// 8 bits a pass, ping-ponging with @p scratch (n entries); returns where the result is (a or
-/// scratch). Each pass is parallel over fixed chunks: per-chunk digit counts, offsets digit by
-/// digit then chunk by chunk, scatter. Stable, so entries with equal keys keep their (index)
-/// order, and the chunks are fixed by n, so the result does not depend on the thread count.
-uint64_t* radixSort(uint64_t* a, uint64_t* scratch, size_t n, int low, int bits) {
-    const Chunks chunks(n);
-    std::vector<std::array<size_t, 256>> start(chunks.count);
-    uint64_t *from = a, *to = scratch;
-    for (int shift = low; shift < low + bits; shift += 8) {
-        tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
-            std::array<size_t, 256>& count = start[c];
-            count.fill(0);
-            for (size_t i = chunks.begin(c); i < chunks.end(c); ++i) ++count[(from[i] >> shift) & 0xff];
-        });
-        size_t total = 0;
-        for (size_t digit = 0; digit < 256; ++digit)
-            for (size_t c = 0; c < chunks.count; ++c) total += std::exchange(start[c][digit], total);
-        tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
-            std::array<size_t, 256>& cursor = start[c];
-            for (size_t i = chunks.begin(c); i < chunks.end(c); ++i) to[cursor[(from[i] >> shift) & 0xff]++] = from[i];
-        });
-        std::swap(from, to);
-    }
-    return from;
-}
 }  // namespace
 
 /// Optical depth and σ-weighted colour of the points of the current slab, per tile pixel
@@ -151,8 +126,7 @@ TileCompositor::TileCompositor(int width, int height, const Tables& tables, cons
       tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact), slabs_(slabs),
       own_(buffers ? nullptr : std::make_unique<CompositorBuffers>()), kept_(buffers ? *buffers : *own_),
       color_(kept_.color), transmittance_(kept_.transmittance), liveCount_(size_t(tilesX_) * tilesY_),
-      order_(kept_.order), sortScratch_(kept_.sortScratch), ranges_(kept_.ranges), chunkCounts_(kept_.chunkCounts),
-      binStart_(kept_.binStart), binEntries_(kept_.binEntries), binCounts_(kept_.binCounts) {
+      binStart_(kept_.binStart), binEntries_(kept_.binEntries), binScratch_(kept_.binScratch), binCounts_(kept_.binCounts) {
     const size_t pixels = size_t(width) * height;
     growDiscarding(color_, pixels), growDiscarding(transmittance_, pixels);  // filled here, in parallel
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, 16384), [&](const tbb::blocked_range<size_t>& r) {
@@ -199,8 +173,7 @@ SkippedPrimitives TileCompositor::composite(std::span<const Primitive> prims, do
 SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, double& binSeconds, double& compositeSeconds) {
     const auto t0 = Clock::now();
     window_ = &window;
-    sortWindow(window);
-    const SkippedPrimitives skipped = binToTiles();
+    const SkippedPrimitives skipped = binWindow(window);
     binSeconds += since(t0);
     const auto t1 = Clock::now();
     // Slabs: every slab before closeBefore is past (the next window's primitives, of slabs ≥
@@ -208,8 +181,11 @@ SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, doubl
     const int64_t closeBefore = window.slabEnd - slabs_.reach;
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX_ * tilesY_, 1), [&](const tbb::blocked_range<int>& r) {
         for (int tile = r.begin(); tile < r.end(); ++tile) {
-            const std::span<const uint32_t> bin(binEntries_.data() + binStart_[size_t(tile)],
-                                                binStart_[size_t(tile) + 1] - binStart_[size_t(tile)]);
+            const size_t first = binStart_[size_t(tile)], count = binStart_[size_t(tile) + 1] - first;
+            const Entry* sorted = count == 0 ? nullptr
+                                             : sortTileEntries(binEntries_.data() + first, binScratch_.data() + first,
+                                                               count, indexBits_, keyBits_);
+            const std::span<const Entry> bin(sorted, count);
             if (slabs_.on) {
                 const SlabRing* ring = rings_[size_t(tile)].get();
                 if (!bin.empty() || (ring && ring->open() && ring->first < closeBefore)) compositeTileSlabs(tile, bin, closeBefore);
@@ -223,20 +199,38 @@ SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, doubl
     return skipped;
 }
 
-/// One global sort by (key, index), then binning in that order: every tile's list comes out in
-/// order without a per-tile sort. The key passes and the binning (binToTiles) are parallel over
-/// fixed chunks of the window; the sort is a parallel radix sort of the packed keys (KeyLayout:
-/// typically 20–30 bits, 3–4 passes, several times faster than a comparison sort of the 16-byte
-/// entries). Nothing depends on the thread count.
-void TileCompositor::sortWindow(const ProjectedWindow& window) {
-    const size_t n = window.size;
+/// Bins the window's drawable primitives into per-tile lists (CSR: binStart_, binEntries_) of sort
+/// entries, key << indexBits_ | index (KeyLayout), each list in index order; the tiles sort their
+/// own lists (sortTileEntries) just before compositing them. Parallel over fixed chunks of the
+/// window in index order, reading 16 bytes a primitive (order, depth, tiles): per chunk, the key range and
+/// the count per tile (skipping tiles already opaque); then the layout, the offsets tile by tile
+/// and chunk by chunk, and the fill. The lists, and each tile's sorted order (the total (key,
+/// index) order restricted to the tile), depend neither on the chunking nor on the thread count.
+/// Before (session 15), the whole window was radix-sorted once and binned in that order: three or
+/// four passes over the window's entries in memory, and every record read in sorted order, a
+/// random line each (docs/performance.md, session 15).
+SkippedPrimitives TileCompositor::binWindow(const ProjectedWindow& window) {
+    const size_t tiles = size_t(tilesX_) * tilesY_, n = window.size;
     const Chunks chunks(n);
     const uint32_t* orderOf = window.order.data();
     const float* depthOf = window.depth.data();
-    // Per chunk: drawable primitives and the range of their keys (8 bytes read per primitive).
+    std::vector<uint32_t>& counts = binCounts_;  // reused: fresh pages cost a fault each on every window
+    counts.assign(chunks.count * tiles, 0);
     std::vector<ChunkRange> range(chunks.count);
+    std::vector<SkippedPrimitives> skippedIn(chunks.count);
+    const uint64_t* tilesOf = window.tiles.data();
+    const auto forTiles = [&](uint64_t rect, auto&& fn) {  // rect: tileRect of the primitive's range
+        const size_t tx0 = rect & 0xffff, ty0 = rect >> 16 & 0xffff, tx1 = rect >> 32 & 0xffff, ty1 = rect >> 48;
+        for (size_t ty = ty0; ty <= ty1; ++ty)
+            for (size_t tile = ty * tilesX_ + tx0, last = ty * tilesX_ + tx1; tile <= last; ++tile)
+                if (liveCount_[tile] > 0) fn(tile);
+    };
+    // Per chunk: the drawable primitives' key range (all of them, as the layout always took) and
+    // the tiles each counts in; a primitive with no live tile is skipped.
     tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
+        uint32_t* count = counts.data() + c * tiles;
         ChunkRange& r = range[c];
+        SkippedPrimitives& skipped = skippedIn[c];
         for (size_t i = chunks.begin(c); i < chunks.end(c); ++i) {
             const uint32_t o = orderOf[i];
             if (o == ProjectedWindow::kNotDrawn) continue;
@@ -244,83 +238,34 @@ void TileCompositor::sortWindow(const ProjectedWindow& window) {
             const uint32_t d = KeyLayout::depthOf(depthOf[i]);
             r.orderLo = std::min(r.orderLo, o), r.orderHi = std::max(r.orderHi, o);
             r.depthLo = std::min(r.depthLo, d), r.depthHi = std::max(r.depthHi, d);
+            bool any = false;
+            forTiles(tilesOf[i], [&](size_t tile) { ++count[tile], any = true; });
+            if (!any) {
+                const PrimitiveRecord& p = window.records[i];
+                ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
+                if (p.kind == PrimitiveKind::SplatExactIndex) ++skipped.exactIndexSplats;
+                skipped.voxels += window.members[i];
+            }
         }
     });
     ChunkRange all;
-    std::vector<size_t>& cursor = chunkCounts_;
-    cursor.assign(chunks.count, 0);
-    for (size_t c = 0; c < chunks.count; ++c) {
-        cursor[c] = all.count, all.count += range[c].count;
-        all.orderLo = std::min(all.orderLo, range[c].orderLo), all.orderHi = std::max(all.orderHi, range[c].orderHi);
-        all.depthLo = std::min(all.depthLo, range[c].depthLo), all.depthHi = std::max(all.depthHi, range[c].depthHi);
+    for (const ChunkRange& r : range) {
+        all.count += r.count;
+        all.orderLo = std::min(all.orderLo, r.orderLo), all.orderHi = std::max(all.orderHi, r.orderHi);
+        all.depthLo = std::min(all.depthLo, r.depthLo), all.depthHi = std::max(all.depthHi, r.depthHi);
     }
-    const size_t total = all.count;
     KeyLayout layout;
-    if (total > 0) {
+    indexBits_ = std::max(1, int(std::bit_width(std::max<size_t>(n, 1) - 1)));
+    if (all.count > 0) {
         // order = relative slab·2 + kind: the slab's bits and the kind's one.
         layout.orderBase = all.orderLo & ~1u, layout.depthBase = all.depthLo;
         const int orderBits = int(std::bit_width(all.orderHi - layout.orderBase));
         const int depthBits = int(std::bit_width(all.depthHi - all.depthLo));
-        indexBits_ = std::max(1, int(std::bit_width(n - 1)));
         layout.depthShift = std::max(0, orderBits + depthBits - (64 - indexBits_));
         layout.depthBits = depthBits - layout.depthShift;
         layout.bits = orderBits + layout.depthBits;
     }
-    // Buffers grow only (default-initialised: nothing is written until the parallel passes).
-    growDiscarding(order_, total), growDiscarding(sortScratch_, total);
-    growDiscarding(ranges_, total);
-    orderCount_ = total;
-    tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
-        size_t k = cursor[c];
-        for (size_t i = chunks.begin(c); i < chunks.end(c); ++i)
-            if (orderOf[i] != ProjectedWindow::kNotDrawn) order_[k++] = layout.key(orderOf[i], depthOf[i]) << indexBits_ | i;
-    });
-    // order_ is in index order; the stable sort by key makes it the total (key, index) order.
-    if (radixSort(order_.data(), sortScratch_.data(), total, indexBits_, layout.bits) != order_.data())
-        std::swap(order_, sortScratch_);
-    // binToTiles bins the primitives in this order.
-}
-
-/// Bins the window's primitives, in sorted order, into per-tile lists of window indices (CSR:
-/// binStart_, binEntries_), skipping tiles that are already opaque. Parallel over fixed chunks of
-/// the sorted order: read each record's range (a random line; gathered into ranges_) and count
-/// per (chunk, tile), prefix sums, fill; the lists do not depend on the chunking. The tiles then
-/// read the window's records in place, a prefetched line each (session 11: gathering the 64-byte
-/// records, the exact-index maps and the slab profiles into sorted copies cost more than it saved).
-SkippedPrimitives TileCompositor::binToTiles() {
-    const size_t tiles = size_t(tilesX_) * tilesY_, n = orderCount_;
-    const Chunks chunks(n);
-    std::vector<uint32_t>& counts = binCounts_;  // reused: fresh pages cost a fault each on every window
-    counts.assign(chunks.count * tiles, 0);
-    std::vector<SkippedPrimitives> skippedIn(chunks.count);
-    const auto forTiles = [&](const PixelRange& range, auto&& fn) {
-        const int tx0 = range.x0 / kTileSize, tx1 = range.x1 / kTileSize;
-        for (int ty = range.y0 / kTileSize; ty <= range.y1 / kTileSize; ++ty)
-            for (int tx = tx0; tx <= tx1; ++tx) {
-                const size_t tile = size_t(ty) * tilesX_ + tx;
-                if (liveCount_[tile] > 0) fn(tile);
-            }
-    };
-    // Each primitive's range, in sorted order, and the tiles it counts in.
-    const ProjectedWindow& window = *window_;
-    tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
-        uint32_t* count = counts.data() + c * tiles;
-        SkippedPrimitives& skipped = skippedIn[c];
-        const size_t end = chunks.end(c);
-        for (size_t k = chunks.begin(c); k < end; ++k) {
-            if (k + 8 < end) __builtin_prefetch(&window.records[indexOf(order_[k + 8])]);  // a random line each
-            const uint32_t i = indexOf(order_[k]);
-            const TileRecord& p = window.records[i];
-            ranges_[k] = p.range;
-            bool any = false;
-            forTiles(p.range, [&](size_t tile) { ++count[tile], any = true; });
-            if (!any) {
-                ++(p.kind == PrimitiveKind::Point ? skipped.points : skipped.splats);
-                if (p.kind == PrimitiveKind::SplatExactIndex) ++skipped.exactIndexSplats;
-                skipped.voxels += window_->members[i];
-            }
-        }
-    });
+    keyBits_ = layout.bits;
     // Offsets: tile by tile, chunk by chunk; counts become each chunk's write cursor.
     binStart_.assign(tiles + 1, 0);
     size_t total = 0;
@@ -333,11 +278,15 @@ SkippedPrimitives TileCompositor::binToTiles() {
         }
     }
     binStart_[tiles] = total;
-    growDiscarding(binEntries_, total);
+    growDiscarding(binEntries_, total), growDiscarding(binScratch_, total);
     tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
         uint32_t* cursor = counts.data() + c * tiles;
-        for (size_t k = chunks.begin(c); k < chunks.end(c); ++k)
-            forTiles(ranges_[k], [&](size_t tile) { binEntries_[cursor[tile]++] = indexOf(order_[k]); });
+        for (size_t i = chunks.begin(c); i < chunks.end(c); ++i) {
+            const uint32_t o = orderOf[i];
+            if (o == ProjectedWindow::kNotDrawn) continue;
+            const Entry e = layout.key(o, depthOf[i]) << indexBits_ | i;
+            forTiles(tilesOf[i], [&](size_t tile) { binEntries_[cursor[tile]++] = e; });
+        }
     });
     SkippedPrimitives skipped;
     for (const SkippedPrimitives& s : skippedIn) {
@@ -463,31 +412,31 @@ void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t i, TilePixels& 
 /// Records are a cache miss each (a tile's list is sparse in the window): fetch them (and, in the
 /// slab order, their profiles) 8 ahead, and an exact-index splat's map (two lines) 4 ahead, once
 /// its record has arrived.
-inline void TileCompositor::prefetchAhead(std::span<const uint32_t> entries, size_t e, bool profiles) const {
+inline void TileCompositor::prefetchAhead(std::span<const Entry> entries, size_t e, bool profiles) const {
     constexpr size_t kAhead = 8, kMapAhead = 4;
     // The prefetches are written out here, not in a helper lambda: GCC compiled the lambda out of
     // line, found it free of side effects and dropped its calls, as it did this whole function.
     if (e + kAhead < entries.size()) {
-        __builtin_prefetch(&window_->records[entries[e + kAhead]]);
+        __builtin_prefetch(&window_->records[indexOf(entries[e + kAhead])]);
         if (profiles) {
-            const char* c = reinterpret_cast<const char*>(&window_->profile[entries[e + kAhead]]);
+            const char* c = reinterpret_cast<const char*>(&window_->profile[indexOf(entries[e + kAhead])]);
             __builtin_prefetch(c), __builtin_prefetch(c + sizeof(SlabProfile) - 1);
         }
     }
-    if (e + kMapAhead < entries.size() && window_->records[entries[e + kMapAhead]].hasExactMap) {
-        const char* c = reinterpret_cast<const char*>(&window_->extra[entries[e + kMapAhead]].exactMap);
+    if (e + kMapAhead < entries.size() && window_->records[indexOf(entries[e + kMapAhead])].hasExactMap) {
+        const char* c = reinterpret_cast<const char*>(&window_->extra[indexOf(entries[e + kMapAhead])].exactMap);
         __builtin_prefetch(c), __builtin_prefetch(c + sizeof(ExactIndexMap) - 1);
     }
 }
 
-void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) {
+void TileCompositor::compositeTile(int tile, std::span<const Entry> entries) {
     TilePixels px;
     loadTile(tile, px);
     SlabBuffer slab;
     int64_t slabOf = std::numeric_limits<int64_t>::min();
     for (size_t e = 0; e < entries.size(); ++e) {
         prefetchAhead(entries, e, false);
-        const uint32_t i = entries[e];
+        const uint32_t i = indexOf(entries[e]);
         const TileRecord& p = window_->records[i];
         const bool isPoint = p.kind == PrimitiveKind::Point;
         if (int64_t(p.slab) != slabOf || !isPoint) {
@@ -505,7 +454,7 @@ void TileCompositor::compositeTile(int tile, std::span<const uint32_t> entries) 
 /// --compositing slabs: each primitive's τ goes to the slabs s − K … s + K of its profile; slabs
 /// before s − K are composited first, in order, and at the end every slab before @p closeBefore
 /// (no later window reaches it). A tile that turned opaque composites and drops all it holds.
-void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entries, int64_t closeBefore) {
+void TileCompositor::compositeTileSlabs(int tile, std::span<const Entry> entries, int64_t closeBefore) {
     std::unique_ptr<SlabRing>& owned = rings_[size_t(tile)];
     if (!owned) owned = std::make_unique<SlabRing>(slabs_.reach);
     SlabRing& ring = *owned;
@@ -521,7 +470,7 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const uint32_t> entr
     const int64_t base = window_->slabBase;
     for (size_t e = 0; e < entries.size(); ++e) {
         prefetchAhead(entries, e, true);
-        const uint32_t i = entries[e];
+        const uint32_t i = indexOf(entries[e]);
         const TileRecord& p = window_->records[i];
         const int64_t slab = base + int64_t(p.slab);
         closeUpTo(slab - reach);

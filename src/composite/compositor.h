@@ -1,8 +1,8 @@
 // composite/compositor.h — the one EWA-filtered, front-to-back compositor (DESIGN §4, §5).
-// Owns: the frame (premultiplied colour and transmittance per pixel), ordering a
-// window's primitives by a (slab, kind, depth, index) key (a stable radix sort of
-// packed keys), binning them in that order to square screen tiles (composite/tile.h),
-// and compositing every tile's list independently and in parallel:
+// Owns: the frame (premultiplied colour and transmittance per pixel), binning a window's
+// primitives to square screen tiles (composite/tile.h), ordering each tile's list by a
+// (slab, kind, depth, index) key (packed keys, sorted in the tile's own task), and
+// compositing every tile's list independently and in parallel:
 //   - points of one slab are summed into a slab buffer (optical depth and
 //     σ-weighted colour) and composited when the slab ends, so side-by-side
 //     points never occlude each other;
@@ -69,12 +69,10 @@ struct CompositorBuffers {
     using Buffer = std::vector<T, HugePageAllocator<T>>;
     Buffer<glm::vec3> color;        ///< the frame: premultiplied radiance
     Buffer<float> transmittance;    ///< the frame: T
-    Buffer<uint64_t> order;         ///< a window's sort entries (key above index)
-    Buffer<uint64_t> sortScratch;   ///< the radix sort's second buffer
-    Buffer<PixelRange> ranges;      ///< the binning's ranges, in sorted order
-    Buffer<uint32_t> binEntries;    ///< per tile: window indices
+    Buffer<uint64_t> binEntries;    ///< per tile: sort entries (key above window index)
+    Buffer<uint64_t> binScratch;    ///< per tile: its sort's second buffer (same offsets)
     std::vector<uint32_t> binCounts;
-    std::vector<size_t> chunkCounts, binStart;
+    std::vector<size_t> binStart;
 };
 
 class TileCompositor {
@@ -125,7 +123,7 @@ private:
         return false;
     }
     /// A sort entry: the key (slab (relative) · kind · depth bits) above the primitive's index
-    /// (the tie-break) in one word, key << indexBits_ | index: 8 bytes a pass, not 16.
+    /// (the tie-break) in one word, key << indexBits_ | index: its value order is the (key, index) order.
     using Entry = uint64_t;
     uint32_t indexOf(Entry e) const { return uint32_t(e & ((uint64_t(1) << indexBits_) - 1)); }
     /// What the tile loop reads of one primitive (PrimitiveRecord, one 64-byte line), in place in
@@ -134,15 +132,14 @@ private:
     struct SlabBuffer;
     struct SlabRing;    // --compositing slabs: one tile's open slabs, kept from window to window
     struct TilePixels;  // one tile's transmittance and colour, copied in and out (thread-local)
-    void sortWindow(const ProjectedWindow& window);
-    SkippedPrimitives binToTiles();
+    SkippedPrimitives binWindow(const ProjectedWindow& window);
     void loadTile(int tile, TilePixels& px) const;
     void storeTile(int tile, const TilePixels& px);
     /// Always inlined: out of line GCC finds it free of side effects (prefetches do not count)
     /// and deletes every call, which silently cost the tile loop 15 % (session 6).
-    [[gnu::always_inline]] inline void prefetchAhead(std::span<const uint32_t> entries, size_t e, bool profiles) const;
-    void compositeTile(int tile, std::span<const uint32_t> entries);
-    void compositeTileSlabs(int tile, std::span<const uint32_t> entries, int64_t closeBefore);
+    [[gnu::always_inline]] inline void prefetchAhead(std::span<const Entry> entries, size_t e, bool profiles) const;
+    void compositeTile(int tile, std::span<const Entry> entries);
+    void compositeTileSlabs(int tile, std::span<const Entry> entries, int64_t closeBefore);
     void closeSlab(TilePixels& px, SlabBuffer& slab) const;  // one "over" per live pixel, then empty
     void drawPrimitive(const TileRecord& p, uint32_t i, TilePixels& px, SlabBuffer* slab, const SlabTargets* slabs) const;
     void drawPoint(const TileRecord& p, const TilePixels& tile, SlabBuffer* slab, const SlabTargets* slabs) const;
@@ -165,15 +162,12 @@ private:
     std::vector<uint32_t> liveRows_;      // per image row and tile column: bit j, pixel j of the tile's row has T ≥ ε
     const ProjectedWindow* window_ = nullptr;  // the window being composited (composite()'s argument)
     ProjectedWindow packed_;              // composite(span<const Primitive>)'s window
-    size_t orderCount_ = 0;               // the window's drawable primitives (the buffers grow only)
     int indexBits_ = 0;                   // the low bits of an Entry that hold the index
-    Buffer<Entry>& order_;                // the window's drawable primitives in (key, index) order
-    Buffer<Entry>& sortScratch_;          // the radix sort's second buffer
-    Buffer<PixelRange>& ranges_;          // ... their pixel ranges, in that order
-    std::vector<size_t>& chunkCounts_;    // sortWindow's per-chunk counts and cursors
+    int keyBits_ = 0;                     // the key's width above them (KeyLayout::bits)
     std::vector<size_t>& binStart_;       // per tile (+1): its list in binEntries_
-    Buffer<uint32_t>& binEntries_;        // per tile: window indices, in (key, index) order
-    std::vector<uint32_t>& binCounts_;    // binToTiles' per-(chunk, tile) counts and cursors
+    Buffer<Entry>& binEntries_;           // per tile: sort entries, in index order until the tile sorts them
+    Buffer<Entry>& binScratch_;           // per tile: the tile sort's second buffer
+    std::vector<uint32_t>& binCounts_;    // binWindow's per-(chunk, tile) counts and cursors
 };
 
 }  // namespace vdbsplat
