@@ -94,6 +94,9 @@ public:
     /// A rectangle wholly off the image covers no pixel, so it is hidden (it would draw nothing).
     bool hidden(int x0, int y0, int x1, int y1) const {
         x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, width_ - 1), y1 = std::min(y1, height_ - 1);
+        if (x0 > x1 || y0 > y1) return true;
+        // Most rectangles' first pixel is still live (one bit of the live rows).
+        if (liveRows_[size_t(y0) * size_t(tilesX_) + size_t(x0 / kTileSize)] >> (x0 % kTileSize) & 1u) return false;
         for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)
             for (int tx = x0 / kTileSize; tx <= x1 / kTileSize; ++tx)
                 if (liveCount_[size_t(ty) * tilesX_ + tx] > 0 && anyLive(tx, ty, x0, y0, x1, y1)) return false;

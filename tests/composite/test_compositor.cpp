@@ -425,6 +425,11 @@ TEST(TileCompositor, HiddenIsExactPerPixel) {
     std::printf("  %d rectangles: %d hidden, %d of them in tiles with live pixels\n", checked, hidden, hiddenInLiveTiles);
     EXPECT_GT(hiddenInLiveTiles, 100);  // the case a tile-level test misses is exercised
     EXPECT_LT(hidden, checked);
+    // A rectangle wholly off the image covers no pixel, so it is hidden (it would draw nothing).
+    EXPECT_TRUE(compositor.hidden(-9, 5, -1, 20));
+    EXPECT_TRUE(compositor.hidden(5, h, 20, h + 9));
+    EXPECT_TRUE(compositor.hidden(w, -3, w + 4, 2));
+    EXPECT_TRUE(compositor.hidden(-40, -40, -33, -33));
 }
 
 // projectBatch is projectVoxel over the batch, in order, with the window's slab and depth, packed
