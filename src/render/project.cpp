@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <array>
 #include <cmath>
 #include <optional>
 
@@ -19,13 +20,6 @@
 namespace vdbsplat {
 
 namespace {
-
-/// floor(x) for a finite x within ±2⁶² (a distance over a slab length): a cast and a compare,
-/// not a libm call.
-int64_t floorToInt64(double x) {
-    const int64_t i = int64_t(x);
-    return i - (double(i) > x ? 1 : 0);
-}
 
 /// --show-primitives: splats tinted red (Yuan et al. 2003, Figure 8a), points unchanged.
 glm::vec3 splatTint(const glm::vec3& c) {
@@ -228,6 +222,9 @@ std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx) {
     return valid ? std::optional(lanes) : std::nullopt;
 }
 
+/// Voxels whose slabs projectBatch computes at once (slabsOf).
+constexpr size_t kSlabBlock = 256;
+
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window) {
     window.slabBase = batch.slabBegin;
     window.slabEnd = batch.slabEnd;
@@ -238,8 +235,15 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
         tbb::blocked_range<size_t>(0, batch.size(), 1024), ProjectionCounts{},
         [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
             SplatLanes lanes;
+            std::array<int64_t, kSlabBlock> slabs;  // voxels [slabsFrom, slabsFrom + kSlabBlock)'s
+            size_t slabsFrom = r.begin(), slabsEnd = r.begin();
             size_t chunk = r.begin(), chunkEnd = r.begin();  // lanes hold voxels [chunk, chunkEnd)
             for (size_t i = r.begin(); i < r.end(); ++i) {
+                if (i == slabsEnd) {
+                    slabsFrom = i, slabsEnd = std::min(r.end(), i + kSlabBlock);
+                    slabsOf(batch.distance.data() + i, slabsEnd - i, ctx.slabLength, batch.slabBegin, batch.slabEnd - 1,
+                            slabs.data());
+                }
                 if (laneContext && i == chunkEnd) {  // the next kSplatLanes voxels, projected at once
                     chunk = i, chunkEnd = std::min(r.end(), i + kSplatLanes);
                     for (size_t k = chunk; k < chunkEnd; ++k) {
@@ -249,8 +253,7 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                     for (size_t k = chunkEnd - chunk; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
                     projectSplatsVector(lanes, chunkEnd - chunk, *laneContext);
                 }
-                const int64_t slab = std::clamp<int64_t>(floorToInt64(batch.distance[i] / ctx.slabLength), batch.slabBegin,
-                                                         batch.slabEnd - 1);
+                const int64_t slab = slabs[i - slabsFrom];  // clamp(⌊distance / slabLength⌋, the batch's slabs)
                 PrimitiveKind kind;
                 PixelRange range;
                 if (laneContext && lanes.status[i - chunk] != SplatLanes::kScalar) {

@@ -8,6 +8,8 @@
 #include <hwy/foreach_target.h>  // must come before highway.h
 #include <hwy/highway.h>
 
+#include <algorithm>
+
 #include "render/project_vector.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -124,6 +126,29 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
     }
 }
 
+void SlabsOf(const float* distance, size_t n, double slabLength, int64_t first, int64_t last, int64_t* slab) {
+    const hn::ScalableTag<double> d;
+    const hn::Rebind<float, decltype(d)> df;
+    const hn::RebindToSigned<decltype(d)> di;
+    const size_t N = hn::Lanes(d);
+    const auto length = hn::Set(d, slabLength);
+    const auto lo = hn::Set(di, first), hi = hn::Set(di, last);
+    const auto slabsAt = [&](auto floats) {  // ⌊d / L⌋ clamped: Floor is exact, the integer fits
+        const auto q = hn::Floor(hn::Div(hn::PromoteTo(d, floats), length));
+        return hn::Min(hn::Max(hn::ConvertTo(di, q), lo), hi);
+    };
+    size_t i = 0;
+    for (; i + N <= n; i += N) hn::StoreU(slabsAt(hn::LoadU(df, distance + i)), di, slab + i);
+    if (i < n) {  // the last n − i through buffers of a whole vector (no access past either array)
+        HWY_ALIGN float in[64] = {};
+        HWY_ALIGN int64_t out[64];
+        static_assert(hn::MaxLanes(d) <= 64);
+        std::copy(distance + i, distance + n, in);
+        hn::Store(slabsAt(hn::Load(df, in)), di, out);
+        std::copy(out, out + (n - i), slab + i);
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace vdbsplat
 HWY_AFTER_NAMESPACE();
@@ -132,6 +157,11 @@ HWY_AFTER_NAMESPACE();
 namespace vdbsplat {
 
 HWY_EXPORT(ProjectSplats);
+HWY_EXPORT(SlabsOf);
+
+void slabsOf(const float* distance, size_t n, double slabLength, int64_t first, int64_t last, int64_t* slab) {
+    HWY_DYNAMIC_DISPATCH(SlabsOf)(distance, n, slabLength, first, last, slab);
+}
 
 void projectSplatsVector(SplatLanes& lanes, size_t n, const SplatLaneContext& ctx) {
     HWY_DYNAMIC_DISPATCH(ProjectSplats)(lanes, n, ctx);

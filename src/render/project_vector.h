@@ -67,4 +67,11 @@ struct SplatLanes {
 /// status and, where the common case holds, the splat (see the file comment).
 void projectSplatsVector(SplatLanes& lanes, size_t n, const SplatLaneContext& ctx);
 
+/// @brief The depth slab of each of @p n distances: clamp(⌊double(distance) / slabLength⌋, @p first,
+/// @p last), vectors at a time (the quotient correctly rounded, as the scalar division is, then
+/// floored: the same integer as floorToInt64 of that quotient). projectBatch's one division per
+/// voxel, out of the loop that builds the primitives, where its latency stalled each voxel.
+/// Distances must be finite and under 2⁶² slab lengths; @p first ≤ @p last.
+void slabsOf(const float* distance, size_t n, double slabLength, int64_t first, int64_t last, int64_t* slab);
+
 }  // namespace vdbsplat

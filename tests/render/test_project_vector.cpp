@@ -5,6 +5,7 @@
 // axis, at the eye plane, behind the eye, off the image and non-finite.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -175,6 +176,44 @@ TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
         ASSERT_EQ(p.color, q.color) << i;
         if (p.hasExactMap) {
             ASSERT_EQ(lanes.extra[i].exactMap.A, scalar.extra[i].exactMap.A) << i;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace vdbsplat
+
+namespace vdbsplat {
+namespace {
+
+/// The slab of one distance as projectBatch computed it voxel by voxel before slabsOf: the
+/// double quotient, floored by a cast and a compare.
+int64_t scalarSlab(float distance, double slabLength, int64_t first, int64_t last) {
+    const double x = double(distance) / slabLength;
+    const int64_t i = int64_t(x);
+    return std::clamp<int64_t>(i - (double(i) > x ? 1 : 0), first, last);
+}
+
+// slabsOf against the scalar quotient and floor, for every count of lanes left over and at the
+// distances where a floor can go wrong: exact multiples of the slab length, the floats either
+// side of them, zero, and the clamps at both ends.
+TEST(ProjectVector, SlabsOfEqualsTheScalarFloor) {
+    std::mt19937 rng(29);
+    std::uniform_real_distribution<float> u(0.f, 60.f);
+    for (const double length : {0.1, 0.5, 1.0, 0.7853981633974483, 3.0}) {
+        std::vector<float> distance;
+        for (int k = 0; k < 200; ++k) {
+            const float m = float(k * length);
+            distance.insert(distance.end(), {m, std::nextafter(m, 0.f), std::nextafter(m, 1e9f), u(rng)});
+        }
+        distance.push_back(0.f);
+        const int64_t first = 3, last = int64_t(45 / length);
+        for (const size_t n : {size_t(0), size_t(1), size_t(7), size_t(8), size_t(9), size_t(255), distance.size()}) {
+            std::vector<int64_t> slab(n + 1, -777);  // one past n: must stay untouched
+            slabsOf(distance.data(), n, length, first, last, slab.data());
+            for (size_t i = 0; i < n; ++i)
+                ASSERT_EQ(slab[i], scalarSlab(distance[i], length, first, last)) << "length " << length << ", distance " << distance[i];
+            EXPECT_EQ(slab[n], -777) << "slabsOf wrote past its n = " << n;
         }
     }
 }
