@@ -206,7 +206,7 @@ SkippedPrimitives TileCompositor::composite(const ProjectedWindow& window, doubl
 /// the count per tile (skipping tiles already opaque); then the layout, the offsets tile by tile
 /// and chunk by chunk, and the fill. The lists, and each tile's sorted order (the total (key,
 /// index) order restricted to the tile), depend neither on the chunking nor on the thread count.
-/// Before (session 15), the whole window was radix-sorted once and binned in that order: three or
+/// Until session 15 the whole window was radix-sorted once and binned in that order: three or
 /// four passes over the window's entries in memory, and every record read in sorted order, a
 /// random line each (docs/performance.md, session 15).
 SkippedPrimitives TileCompositor::binWindow(const ProjectedWindow& window) {
