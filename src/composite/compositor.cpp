@@ -10,7 +10,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <utility>
 
 #include "composite/opacity.h"
 #include "composite/point_raster.h"
@@ -44,8 +43,8 @@ struct KeyLayout {
     }
 };
 
-/// The fixed chunks a window's n entries are cut into for the parallel passes (key ranges, radix
-/// sort, binning): by n alone, never by the thread count, so nothing depends on it. 4 096
+/// The fixed chunks a window's n entries are cut into for the binning's parallel passes (key
+/// ranges and counts, fill): by n alone, never by the thread count, so nothing depends on it. 4 096
 /// entries a chunk (up to 64 chunks): 16 384 made a typical 50k-entry window 3 chunks for 2
 /// threads, at most 1.5× (session 11).
 struct Chunks {

@@ -222,9 +222,6 @@ std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx) {
     return valid ? std::optional(lanes) : std::nullopt;
 }
 
-/// Voxels whose slabs projectBatch computes at once (slabsOf).
-constexpr size_t kSlabBlock = 256;
-
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window) {
     window.slabBase = batch.slabBegin;
     window.slabEnd = batch.slabEnd;
@@ -235,25 +232,23 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
         tbb::blocked_range<size_t>(0, batch.size(), 1024), ProjectionCounts{},
         [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
             SplatLanes lanes;
-            std::array<int64_t, kSlabBlock> slabs;  // voxels [slabsFrom, slabsFrom + kSlabBlock)'s
-            size_t slabsFrom = r.begin(), slabsEnd = r.begin();
-            size_t chunk = r.begin(), chunkEnd = r.begin();  // lanes hold voxels [chunk, chunkEnd)
+            std::array<int64_t, kSplatLanes> slabs;  // of voxels [chunk, chunkEnd)
+            size_t chunk = r.begin(), chunkEnd = r.begin();  // the voxels of the current chunk
             for (size_t i = r.begin(); i < r.end(); ++i) {
-                if (i == slabsEnd) {
-                    slabsFrom = i, slabsEnd = std::min(r.end(), i + kSlabBlock);
-                    slabsOf(batch.distance.data() + i, slabsEnd - i, ctx.slabLength, batch.slabBegin, batch.slabEnd - 1,
-                            slabs.data());
-                }
-                if (laneContext && i == chunkEnd) {  // the next kSplatLanes voxels, projected at once
+                if (i == chunkEnd) {  // the next kSplatLanes voxels: their slabs, and their splats projected at once
                     chunk = i, chunkEnd = std::min(r.end(), i + kSplatLanes);
-                    for (size_t k = chunk; k < chunkEnd; ++k) {
-                        lanes.x[k - chunk] = batch.viewPos[k].x, lanes.y[k - chunk] = batch.viewPos[k].y;
-                        lanes.z[k - chunk] = batch.viewPos[k].z;
+                    slabsOf(batch.distance.data() + chunk, chunkEnd - chunk, ctx.slabLength, batch.slabBegin,
+                            batch.slabEnd - 1, slabs.data());
+                    if (laneContext) {
+                        for (size_t k = chunk; k < chunkEnd; ++k) {
+                            lanes.x[k - chunk] = batch.viewPos[k].x, lanes.y[k - chunk] = batch.viewPos[k].y;
+                            lanes.z[k - chunk] = batch.viewPos[k].z;
+                        }
+                        for (size_t k = chunkEnd - chunk; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
+                        projectSplatsVector(lanes, chunkEnd - chunk, *laneContext);
                     }
-                    for (size_t k = chunkEnd - chunk; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
-                    projectSplatsVector(lanes, chunkEnd - chunk, *laneContext);
                 }
-                const int64_t slab = slabs[i - slabsFrom];  // clamp(⌊distance / slabLength⌋, the batch's slabs)
+                const int64_t slab = slabs[i - chunk];  // clamp(⌊distance / slabLength⌋, the batch's slabs)
                 PrimitiveKind kind;
                 PixelRange range;
                 if (laneContext && lanes.status[i - chunk] != SplatLanes::kScalar) {
