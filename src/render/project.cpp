@@ -165,7 +165,38 @@ PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const 
     return kind;
 }
 
+/// makePoint's point, set up as setUpPointFilter does, from lane @p k of a projectPointsVector
+/// call, stored straight into @p window as primitive @p i (as storeLaneSplat); sets @p range.
+void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const VoxelBatch& batch, int64_t slab,
+                    const ProjectionContext& ctx, ProjectedWindow& window, PixelRange& range) {
+    PrimitiveRecord& q = window.records[i];
+    q.kind = PrimitiveKind::Point;
+    q.hasExactMap = false;
+    q.centre = glm::vec2(lanes.centreX[k], lanes.centreY[k]);
+    q.shape = glm::vec3(lanes.invVariance[k], lanes.total[k], lanes.norm[k]);
+    q.scale = lanes.radius2[k];
+    q.sin2Alpha = 0.f;
+    q.color = batch.color[i];  // points are never tinted
+    q.range = range = lanes.range(k, ctx.camera.width(), ctx.camera.height());
+    window.place(i, slab, batch.distance[i], batch.members[i]);
+}
+
 }  // namespace
+
+std::optional<PointLaneContext> pointLaneContext(const ProjectionContext& ctx) {
+    if (!ctx.vector || (ctx.shape && !ctx.shape->sphere) || ctx.mode != RenderMode::Hybrid) return std::nullopt;
+    PointLaneContext lanes;
+    lanes.focal = ctx.camera.focal();
+    lanes.principalX = ctx.camera.principal().x, lanes.principalY = ctx.camera.principal().y;
+    lanes.spacingTimesFocal = ctx.voxelSize * ctx.camera.focal();
+    lanes.threshold = ctx.threshold;
+    lanes.voxelSize = ctx.voxelSize;
+    lanes.prefilterVariance = ctx.prefilterVariance;
+    lanes.kernelSigma = ctx.tables.kernel->sigma();
+    lanes.width = ctx.camera.width(), lanes.height = ctx.camera.height();
+    lanes.table = &standardPointFilterTable();
+    return lanes;
+}
 
 Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color, const ProjectionContext& ctx,
                        float spreadPx2) {
@@ -228,10 +259,13 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
     window.profiles = ctx.slabs.on;
     window.resize(batch.size());
     const std::optional<SplatLaneContext> laneContext = splatLaneContext(ctx);
+    // Points in lanes too where the splats are (hybrid): the far views' and the clouds' voxels.
+    const std::optional<PointLaneContext> pointContext = laneContext ? pointLaneContext(ctx) : std::nullopt;
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, batch.size(), 1024), ProjectionCounts{},
         [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
             SplatLanes lanes;
+            PointLanes points;
             std::array<int64_t, kSplatLanes> slabs;  // of voxels [chunk, chunkEnd)
             size_t chunk = r.begin(), chunkEnd = r.begin();  // the voxels of the current chunk
             for (size_t i = r.begin(); i < r.end(); ++i) {
@@ -246,6 +280,14 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                         }
                         for (size_t k = chunkEnd - chunk; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
                         projectSplatsVector(lanes, chunkEnd - chunk, *laneContext);
+                        if (pointContext) {
+                            const size_t n = chunkEnd - chunk;
+                            std::copy_n(batch.sigma.data() + chunk, n, points.sigma);
+                            std::copy_n(batch.spread.data() + chunk, n, points.spread);
+                            std::fill(points.sigma + n, points.sigma + kSplatLanes, 0.f);
+                            std::fill(points.spread + n, points.spread + kSplatLanes, 0.f);
+                            projectPointsVector(lanes, points, n, *pointContext);
+                        }
                     }
                 }
                 const int64_t slab = slabs[i - chunk];  // clamp(⌊distance / slabLength⌋, the batch's slabs)
@@ -253,6 +295,9 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                 PixelRange range;
                 if (laneContext && lanes.status[i - chunk] != SplatLanes::kScalar) {
                     kind = storeLaneSplat(lanes, i - chunk, i, batch, slab, ctx, window, range);
+                } else if (pointContext && points.status[i - chunk] == PointLanes::kPoint) {
+                    storeLanePoint(points, i - chunk, i, batch, slab, ctx, window, range);
+                    kind = PrimitiveKind::Point;
                 } else {
                     Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
                     p.members = batch.members[i];

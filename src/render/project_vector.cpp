@@ -10,6 +10,9 @@
 
 #include <algorithm>
 
+#include "pointfilter/point_weight-inl.h"
+
+#include "pointfilter/point_filter.h"
 #include "render/project_vector.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -126,6 +129,143 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
     }
 }
 
+/// makePoint's point (centre, V_point, total, whether it is culled) and pointSetupBox's box, in double lanes;
+/// the float values the record keeps are stored in @p P. Lanes [0, m) are computed (m a whole
+/// number of float vectors; the caller zeroes the inputs past n).
+void PointBoxes(const SplatLanes& L, PointLanes& P, size_t m, const PointLaneContext& ctx) {
+    const hn::ScalableTag<double> d;
+    const hn::Rebind<float, decltype(d)> df;
+    const hn::Rebind<int32_t, decltype(d)> di;
+    using V = hn::Vec<decltype(d)>;
+    const size_t N = hn::Lanes(d);
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0), half = hn::Set(d, 0.5);
+    const V f = hn::Set(d, ctx.focal), px = hn::Set(d, ctx.principalX), py = hn::Set(d, ctx.principalY);
+    const V hf = hn::Set(d, ctx.spacingTimesFocal), threshold = hn::Set(d, ctx.threshold);
+    const V h = hn::Set(d, ctx.voxelSize), M = hn::Set(d, ctx.voxelSize * ctx.voxelSize * ctx.voxelSize);
+    const V prefilter = hn::Set(d, ctx.prefilterVariance), sg = hn::Set(d, ctx.kernelSigma);
+    const V maxRadius = hn::Set(d, kPointMaxRadiusPx), sigmas = hn::Set(d, kPointSupportSigmas);
+    const V maxSide = hn::Set(d, double(kPointMaxSide));
+    const V width = hn::Set(d, double(ctx.width)), height = hn::Set(d, double(ctx.height));
+    for (size_t i = 0; i < m; i += N) {
+        const V x = hn::Load(d, L.x + i), y = hn::Load(d, L.y + i), z = hn::Load(d, L.z + i);
+        // projectVoxel: a point where z > 0 and h·f/z < threshold (the splat lanes' complement).
+        const V spacing = hn::Div(hf, z);
+        const auto point = hn::And(hn::And(hn::And(hn::IsFinite(x), hn::IsFinite(y)), hn::And(hn::IsFinite(z), hn::Gt(z, zero))),
+                                   hn::Lt(spacing, threshold));
+        // Camera::project: (px + f·x/z, py − f·y/z).
+        const V cx = hn::Add(px, hn::Div(hn::Mul(f, x), z)), cy = hn::Sub(py, hn::Div(hn::Mul(f, y), z));
+        // pointFilterVariance(h·f/z) + spread: (V_h + (s_g·spacing)²) + spread, rounded to float.
+        const V s = hn::Mul(sg, spacing);
+        const auto varianceF = hn::DemoteTo(df, hn::Add(hn::Add(prefilter, hn::Mul(s, s)), hn::PromoteTo(d, hn::Load(df, P.spread + i))));
+        // pointDepositTotal(σ/h, h, f, c): σ_w·M·(f/z)·(f/z)·(|c|/z), |c| = √((x² + y²) + z²).
+        const V fz = hn::Div(f, z);
+        const V length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(x, x), hn::Mul(y, y)), hn::Mul(z, z)));
+        const V sigmaW = hn::Div(hn::PromoteTo(d, hn::Load(df, P.sigma + i)), h);
+        const auto totalF = hn::DemoteTo(df, hn::Mul(hn::Mul(hn::Mul(hn::Mul(sigmaW, M), fz), fz), hn::Div(length, z)));
+        // pixelRange of the box centre ± kPointMaxRadiusPx (as ProjectSplats' first and last).
+        const auto first = [&](V lo, V size) {
+            const V t = hn::Min(hn::Max(hn::Sub(lo, half), zero), size);
+            const V k = hn::Trunc(t);
+            return hn::IfThenElse(hn::Lt(k, t), hn::Add(k, one), k);
+        };
+        const auto last = [&](V hi, V size) {
+            const V t = hn::Min(hn::Max(hn::Sub(hi, half), hn::Neg(one)), hn::Sub(size, one));
+            const V k = hn::Trunc(t);
+            return hn::IfThenElse(hn::Gt(k, t), hn::Sub(k, one), k);
+        };
+        const auto onImage = hn::And(hn::Ge(last(hn::Add(cx, maxRadius), width), first(hn::Sub(cx, maxRadius), width)),
+                                     hn::Ge(last(hn::Add(cy, maxRadius), height), first(hn::Sub(cy, maxRadius), height)));
+        const auto kept = hn::And(hn::And(hn::IsFinite(cx), hn::IsFinite(cy)),
+                                  hn::And(onImage, hn::Gt(hn::PromoteTo(d, totalF), zero)));
+        // setUpPointFilter from the float centre and variance: pointSetupBox's rs, box, 1/V, r_s².
+        const auto cxF = hn::DemoteTo(df, cx), cyF = hn::DemoteTo(df, cy);
+        const V cxs = hn::PromoteTo(d, cxF), cys = hn::PromoteTo(d, cyF), variance = hn::PromoteTo(d, varianceF);
+        const auto boxable = hn::And(hn::Gt(variance, zero), hn::IsFinite(variance));  // else the scalar path
+        const V rs = hn::Min(hn::Mul(sigmas, hn::Sqrt(variance)), maxRadius);
+        const auto box = [&](V c, V& origin, V& count) {
+            const V lo = hn::Sub(c, half);
+            origin = hn::Add(hn::Floor(hn::Sub(lo, rs)), one);
+            count = hn::Min(hn::Max(hn::Sub(hn::Ceil(hn::Add(lo, rs)), origin), zero), maxSide);
+        };
+        V x0, nx, y0, ny;
+        box(cxs, x0, nx), box(cys, y0, ny);
+        hn::Store(cxF, df, P.centreX + i), hn::Store(cyF, df, P.centreY + i);
+        hn::Store(varianceF, df, P.variance + i), hn::Store(totalF, df, P.total + i);
+        hn::Store(hn::DemoteTo(df, hn::Div(one, variance)), df, P.invVariance + i);
+        hn::Store(hn::DemoteTo(df, hn::Mul(rs, rs)), df, P.radius2 + i);
+        // Lanes not kept or not boxable hold any integers here: a small box keeps the sums' loop in range.
+        const auto valid = hn::And(kept, boxable);
+        hn::Store(hn::DemoteTo(di, hn::IfThenElseZero(valid, x0)), di, P.x0 + i);
+        hn::Store(hn::DemoteTo(di, hn::IfThenElseZero(valid, y0)), di, P.y0 + i);
+        hn::Store(hn::DemoteTo(di, hn::IfThenElseZero(valid, nx)), di, P.nx + i);
+        hn::Store(hn::DemoteTo(di, hn::IfThenElseZero(valid, ny)), di, P.ny + i);
+        // Status: a point (its filter's sum decides below), or the scalar path's, which also
+        // culls (rare: the stream culls blocks off the image or transparent; the scalar path
+        // writes the culled record's fields as projectVoxel has them).
+        const V status = hn::IfThenElseZero(hn::And(point, valid), hn::Set(d, double(PointLanes::kPoint)));
+        alignas(64) double st[HWY_MAX_BYTES / sizeof(double)];
+        hn::Store(status, d, st);
+        for (size_t k = 0; k < N && i + k < m; ++k) P.status[i + k] = uint8_t(st[k]);
+    }
+}
+
+/// setupPoint's sum for a vector of points at once, each lane one point: the weights of its
+/// kPointMaxSide columns and rows (PointWeight), each column summed down its rows in order (a
+/// pixel outside the circle, a row past ny or a column past nx adding +0), then the columns
+/// pairwise (sumColumnsPairwise). Stores 1/sum as the norm, and the sum.
+void PointSums(PointLanes& P, size_t m, const PointFilterTable& table, float* sums) {
+    const hn::ScalableTag<float> d;
+    const hn::RebindToSigned<decltype(d)> di;
+    using V = hn::Vec<decltype(d)>;
+    const size_t N = hn::Lanes(d);
+    const V half = hn::Set(d, 0.5f), zero = hn::Zero(d);
+    for (size_t i = 0; i < m; i += N) {
+        const V cx = hn::Load(d, P.centreX + i), cy = hn::Load(d, P.centreY + i);
+        const V invV = hn::Load(d, P.invVariance + i), rs2 = hn::Load(d, P.radius2 + i);
+        const auto x0 = hn::Load(di, P.x0 + i), y0 = hn::Load(di, P.y0 + i);
+        const auto nx = hn::Load(di, P.nx + i), ny = hn::Load(di, P.ny + i);
+        V dx2[kPointMaxSide], gx[kPointMaxSide], dy2[kPointMaxSide], gy[kPointMaxSide];
+        for (int k = 0; k < kPointMaxSide; ++k) {
+            // (i + ½) − c in float: one rounding of the exact difference (PointSetup::offset).
+            const V ox = hn::Sub(hn::Add(hn::ConvertTo(d, hn::Add(x0, hn::Set(di, k))), half), cx);
+            const V oy = hn::Sub(hn::Add(hn::ConvertTo(d, hn::Add(y0, hn::Set(di, k))), half), cy);
+            dx2[k] = hn::Mul(ox, ox), dy2[k] = hn::Mul(oy, oy);
+            gx[k] = PointWeight(d, table, hn::Mul(dx2[k], invV));
+            gy[k] = PointWeight(d, table, hn::Mul(dy2[k], invV));
+        }
+        V columns[kPointSumColumns];
+        for (int ix = 0; ix < kPointSumColumns; ++ix) {
+            columns[ix] = zero;
+            if (ix >= kPointMaxSide) continue;
+            const auto column = hn::RebindMask(d, hn::Lt(hn::Set(di, ix), nx));
+            for (int iy = 0; iy < kPointMaxSide; ++iy) {
+                const auto in = hn::And(hn::And(column, hn::RebindMask(d, hn::Lt(hn::Set(di, iy), ny))),
+                                        hn::Lt(hn::Add(dx2[ix], dy2[iy]), rs2));
+                columns[ix] = hn::Add(columns[ix], hn::IfThenElseZero(in, hn::Mul(gx[ix], gy[iy])));
+            }
+        }
+        const V sum = hn::Add(hn::Add(hn::Add(columns[0], columns[1]), hn::Add(columns[2], columns[3])),
+                              hn::Add(hn::Add(columns[4], columns[5]), hn::Add(columns[6], columns[7])));
+        hn::Store(sum, d, sums + i);
+        hn::Store(hn::Div(hn::Set(d, 1.f), sum), d, P.norm + i);
+    }
+}
+
+void ProjectPoints(const SplatLanes& L, PointLanes& P, size_t n, const PointLaneContext& ctx) {
+    constexpr size_t kVector = 16;  // a whole number of float vectors on every target (≤ 16 lanes)
+    static_assert(kSplatLanes % kVector == 0 && hn::MaxLanes(hn::ScalableTag<float>()) <= kVector);
+    const size_t m = (n + kVector - 1) / kVector * kVector;
+    PointBoxes(L, P, m, ctx);
+    bool any = false;
+    for (size_t k = 0; k < n; ++k) any |= P.status[k] == PointLanes::kPoint;
+    if (!any) return;
+    alignas(64) float sums[kSplatLanes];
+    PointSums(P, m, *ctx.table, sums);
+    // finishPointSetup's one-pixel fallback (an empty sum) stays with the scalar path.
+    for (size_t k = 0; k < n; ++k)
+        if (P.status[k] == PointLanes::kPoint && !(sums[k] > 0.f)) P.status[k] = PointLanes::kScalar;
+}
+
 void SlabsOf(const float* distance, size_t n, double slabLength, int64_t first, int64_t last, int64_t* slab) {
     const hn::ScalableTag<double> d;
     const hn::Rebind<float, decltype(d)> df;
@@ -157,7 +297,12 @@ HWY_AFTER_NAMESPACE();
 namespace vdbsplat {
 
 HWY_EXPORT(ProjectSplats);
+HWY_EXPORT(ProjectPoints);
 HWY_EXPORT(SlabsOf);
+
+void projectPointsVector(const SplatLanes& in, PointLanes& out, size_t n, const PointLaneContext& ctx) {
+    HWY_DYNAMIC_DISPATCH(ProjectPoints)(in, out, n, ctx);
+}
 
 void slabsOf(const float* distance, size_t n, double slabLength, int64_t first, int64_t last, int64_t* slab) {
     HWY_DYNAMIC_DISPATCH(SlabsOf)(distance, n, slabLength, first, last, slab);

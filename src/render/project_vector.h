@@ -10,6 +10,7 @@
 // are marked for the scalar path, which decides them as before.
 #pragma once
 #include <cstddef>
+#include <algorithm>
 #include <cstdint>
 #include <glm/glm.hpp>
 
@@ -66,6 +67,50 @@ struct SplatLanes {
 /// @brief Projects lanes [0, @p n) of @p lanes (n ≤ kSplatLanes; x, y, z set), writing their
 /// status and, where the common case holds, the splat (see the file comment).
 void projectSplatsVector(SplatLanes& lanes, size_t n, const SplatLaneContext& ctx);
+
+class PointFilterTable;
+
+/// What every point lane shares (hybrid, sphere kernels; from ProjectionContext).
+struct PointLaneContext {
+    double focal = 1.0;                  ///< f (pixels)
+    double principalX = 0.0, principalY = 0.0;
+    double spacingTimesFocal = 0.0;      ///< h·f: the projected spacing is h·f/z
+    double threshold = 0.0;              ///< a point where h·f/z < threshold
+    double voxelSize = 1.0;              ///< h (world units)
+    double prefilterVariance = 0.0;      ///< V_h folded into each point (px²)
+    double kernelSigma = 1.0;            ///< s_g (voxels)
+    int width = 0, height = 0;           ///< image size (pixels)
+    const PointFilterTable* table = nullptr;  ///< the points' filter (standardPointFilterTable)
+};
+
+/// The minified voxels of one call (DESIGN §4), structure of arrays: makePoint's point and
+/// setUpPointFilter's filter for every lane the splat lanes left to the scalar path that is a
+/// point in hybrid (z > 0, h·f/z < threshold, finite). In: sigma (per voxel length) and spread
+/// (an aggregate's, px²) per lane, the positions from SplatLanes. Out, per lane: `status` kPoint
+/// and the record's fields, or kScalar: the scalar path decides (not a point, or a case it
+/// keeps: a point makePoint culls, the one-pixel fallback of an empty filter sum).
+struct PointLanes {
+    static constexpr uint8_t kScalar = 0, kPoint = 1;
+    alignas(64) float sigma[kSplatLanes], spread[kSplatLanes];
+    alignas(64) float centreX[kSplatLanes], centreY[kSplatLanes];  ///< the float centre the record keeps
+    alignas(64) float variance[kSplatLanes];                       ///< V_point (float, as Primitive::variance)
+    alignas(64) float total[kSplatLanes];                          ///< Σ_pixels τ
+    alignas(64) float invVariance[kSplatLanes], radius2[kSplatLanes], norm[kSplatLanes];  ///< PointSetup's
+    alignas(64) int32_t x0[kSplatLanes], y0[kSplatLanes], nx[kSplatLanes], ny[kSplatLanes];  ///< the footprint (not clamped)
+    uint8_t status[kSplatLanes];
+
+    /// Lane @p i's footprint clamped to the image (setUpPointFilter's range).
+    PixelRange range(size_t i, int width, int height) const {
+        return {std::max(x0[i], 0), std::max(y0[i], 0), std::min(x0[i] + nx[i] - 1, width - 1),
+                std::min(y0[i] + ny[i] - 1, height - 1)};
+    }
+};
+
+/// @brief The points among lanes [0, @p n) of @p in (after projectSplatsVector: only its kScalar
+/// lanes are looked at), into @p out (sigma and spread set): makePoint and setUpPointFilter's
+/// double and float operations in the same order, so the same record bit for bit (the scalar
+/// path is the oracle; tests/render/test_project_vector.cpp), 16 points' filter sums at once.
+void projectPointsVector(const SplatLanes& in, PointLanes& out, size_t n, const PointLaneContext& ctx);
 
 /// @brief The depth slab of each of @p n distances: clamp(⌊double(distance) / slabLength⌋, @p first,
 /// @p last), vectors at a time (the quotient correctly rounded, as the scalar division is, then

@@ -15,6 +15,7 @@
 #include "footprint/tables.h"
 #include "render/project.h"
 #include "support/projection.h"
+#include "support/targets.h"
 #include "render/project_vector.h"
 
 namespace vdbsplat {
@@ -124,6 +125,102 @@ TEST(ProjectVector, LanesEqualTheScalarProjection) {
             }
 }
 
+/// The points' lanes (projectPointsVector) against projectVoxel's makePoint and setUpPointFilter:
+/// every lane taken as a point must be the scalar path's primitive bit for bit, and every
+/// minified voxel makePoint keeps must be taken (culled points and the one-pixel fallback of an
+/// empty filter sum are the scalar path's).
+void checkPointLanes(const ProjectionContext& ctx, const std::vector<glm::vec3>& voxels, Coverage& cov) {
+    const std::optional<SplatLaneContext> lc = splatLaneContext(ctx);
+    const std::optional<PointLaneContext> pc = pointLaneContext(ctx);
+    ASSERT_TRUE(lc.has_value() && pc.has_value());
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    SplatLanes lanes;
+    PointLanes points;
+    for (size_t begin = 0; begin < voxels.size(); begin += kSplatLanes) {
+        const size_t n = std::min(kSplatLanes, voxels.size() - begin);
+        for (size_t k = 0; k < kSplatLanes; ++k) {
+            const glm::vec3 c = k < n ? voxels[begin + k] : glm::vec3(0.f);
+            lanes.x[k] = c.x, lanes.y[k] = c.y, lanes.z[k] = c.z;
+            // σ: mostly ordinary, some 0 and some so small that the total underflows (both culled);
+            // spread: a voxel's 0 or an aggregate's.
+            const float r = u(rng);
+            points.sigma[k] = k >= n ? 0.f : r < 0.05f ? 0.f : r < 0.1f ? 1e-44f : 0.05f + 3.f * u(rng);
+            points.spread[k] = k >= n || u(rng) < 0.5f ? 0.f : 2.f * u(rng);
+        }
+        projectSplatsVector(lanes, n, *lc);
+        projectPointsVector(lanes, points, n, *pc);
+        for (size_t k = 0; k < n; ++k) {
+            const glm::vec3 c = voxels[begin + k];
+            const Primitive q = projectVoxel(glm::dvec3(c), points.sigma[k], glm::vec3(0.2f, 0.5f, 0.9f), ctx, points.spread[k]);
+            const bool point = std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && c.z > 0.f &&
+                               ctx.voxelSize * ctx.camera.focal() / double(c.z) < ctx.threshold;
+            const uint8_t status = points.status[k];
+            SCOPED_TRACE("voxel " + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z));
+            if (!point) {
+                ASSERT_EQ(status, PointLanes::kScalar);
+                ++cov.declined;
+                continue;
+            }
+            ASSERT_EQ(lanes.status[k], SplatLanes::kScalar);  // the splat lanes left it
+            if (q.kind == PrimitiveKind::Culled) {
+                ASSERT_EQ(status, PointLanes::kScalar);
+                ++cov.offImage;
+                continue;
+            }
+            ASSERT_EQ(q.kind, PrimitiveKind::Point);
+            if (status == PointLanes::kScalar) {  // only the one-pixel fallback
+                ASSERT_EQ(q.pointRadius2, INFINITY);
+                ++cov.exact;
+                continue;
+            }
+            ASSERT_EQ(status, PointLanes::kPoint);
+            ++cov.splats;
+            ASSERT_EQ(q.centre, glm::vec2(points.centreX[k], points.centreY[k]));
+            ASSERT_EQ(q.variance, points.variance[k]);
+            ASSERT_EQ(q.total, points.total[k]);
+            ASSERT_EQ(q.pointInvVariance, points.invVariance[k]);
+            ASSERT_EQ(q.pointRadius2, points.radius2[k]);
+            ASSERT_EQ(q.pointNorm, points.norm[k]);
+            const PixelRange r = points.range(k, ctx.camera.width(), ctx.camera.height());
+            ASSERT_TRUE(r.x0 == q.range.x0 && r.y0 == q.range.y0 && r.x1 == q.range.x1 && r.y1 == q.range.y1);
+        }
+    }
+}
+
+TEST(ProjectVector, PointLanesEqualTheScalarProjection) {
+    const Camera camera = testCamera(64);
+    const std::vector<glm::vec3> voxels = testVoxels();
+    // Thresholds that make the far third of the voxels points, and most of them; the low-pass
+    // as the prefilter order's, the postfilter's small one, and none (the filter of the voxel alone).
+    for (const double threshold : {1.0, 4.0})
+        for (const double prefilter : {kPrefilterVariance, 0.1, 0.0}) {
+            ProjectionContext ctx{camera, tables(), 0.1, 0.1, RenderMode::Hybrid, threshold, FootprintPath::Auto, false, prefilter};
+            SCOPED_TRACE("threshold " + std::to_string(threshold) + " prefilter " + std::to_string(prefilter));
+            test::forEachTarget([&] {
+                Coverage cov;  // splats: points taken; offImage: culled points; exact: fallbacks; declined: not points
+                checkPointLanes(ctx, voxels, cov);
+                EXPECT_GT(cov.splats, 300);
+                EXPECT_GT(cov.offImage, 100);
+                EXPECT_GT(cov.declined, 300);
+            });
+        }
+}
+
+// The points' lanes serve hybrid only, sphere kernels, --simd on.
+TEST(ProjectVector, PointLanesServeHybridWithSimd) {
+    const Camera camera = testCamera(64);
+    ProjectionContext ctx{camera, tables(), 0.1, 0.1, RenderMode::Hybrid, 1.0, FootprintPath::Auto, false};
+    EXPECT_TRUE(pointLaneContext(ctx).has_value());
+    ctx.vector = false;
+    EXPECT_FALSE(pointLaneContext(ctx).has_value());
+    ctx.vector = true;
+    for (const RenderMode mode : {RenderMode::Point, RenderMode::Splat, RenderMode::Ewa, RenderMode::Swan, RenderMode::None}) {
+        ctx.mode = mode;
+        EXPECT_FALSE(pointLaneContext(ctx).has_value()) << toString(mode);
+    }
+}
+
 // A context the lanes do not serve takes the scalar path for every voxel.
 TEST(ProjectVector, OnlyServesSphereSplatsWithSimd) {
     const Camera camera = testCamera(64);
@@ -151,7 +248,7 @@ TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
         batch.distance.push_back(std::isfinite(glm::length(voxels[i])) ? glm::length(voxels[i]) : 0.f);
         batch.sigma.push_back(0.1f + float(i % 7));
         batch.color.emplace_back(0.3f, float(i % 3) / 3.f, 1.f);
-        batch.spread.push_back(0.f);
+        batch.spread.push_back(i % 3 == 0 ? 0.25f * float(i % 11) : 0.f);  // aggregates' spread beside voxels'
         batch.members.push_back(1 + uint32_t(i % 4));
     }
     batch.slabBegin = 0, batch.slabEnd = 1000;
@@ -164,6 +261,9 @@ TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
     EXPECT_EQ(a.splats, b.splats);
     EXPECT_EQ(a.exactIndexSplats, b.exactIndexSplats);
     EXPECT_EQ(a.drawnVoxels, b.drawnVoxels);
+    EXPECT_EQ(a.lodAggregates, b.lodAggregates);
+    EXPECT_GT(a.points, 1000);  // both lane paths are exercised
+    EXPECT_GT(a.splats, 1000);
     ASSERT_EQ(lanes.size, scalar.size);
     for (size_t i = 0; i < lanes.size; ++i) {
         ASSERT_EQ(lanes.order[i], scalar.order[i]) << i;
@@ -174,6 +274,13 @@ TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
         ASSERT_EQ(p.shape, q.shape) << i;
         ASSERT_EQ(p.scale, q.scale) << i;
         ASSERT_EQ(p.color, q.color) << i;
+        ASSERT_EQ(p.sin2Alpha, q.sin2Alpha) << i;
+        ASSERT_EQ(p.slab, q.slab) << i;
+        ASSERT_TRUE(p.range.x0 == q.range.x0 && p.range.y0 == q.range.y0 && p.range.x1 == q.range.x1 &&
+                    p.range.y1 == q.range.y1) << i;
+        ASSERT_EQ(lanes.tiles[i], scalar.tiles[i]) << i;
+        ASSERT_EQ(lanes.depth[i], scalar.depth[i]) << i;
+        ASSERT_EQ(lanes.members[i], scalar.members[i]) << i;
         if (p.hasExactMap) {
             ASSERT_EQ(lanes.extra[i].exactMap.A, scalar.extra[i].exactMap.A) << i;
         }
