@@ -152,6 +152,16 @@ void PointBoxes(const SplatLanes& L, PointLanes& P, size_t m, const PointLaneCon
         const V spacing = hn::Div(hf, z);
         const auto point = hn::And(hn::And(hn::And(hn::IsFinite(x), hn::IsFinite(y)), hn::And(hn::IsFinite(z), hn::Gt(z, zero))),
                                    hn::Lt(spacing, threshold));
+        if (hn::AllFalse(d, point)) {  // all splats (framed and close views) or the scalar path's
+            for (size_t k = 0; k < N && i + k < m; ++k) P.status[i + k] = PointLanes::kScalar;
+            // An empty sum of defined values for PointSums, which runs over whole vectors.
+            const auto zeroF = hn::Zero(df);
+            hn::Store(zeroF, df, P.centreX + i), hn::Store(zeroF, df, P.centreY + i);
+            hn::Store(zeroF, df, P.invVariance + i), hn::Store(zeroF, df, P.radius2 + i);
+            hn::Store(hn::Zero(di), di, P.x0 + i), hn::Store(hn::Zero(di), di, P.y0 + i);
+            hn::Store(hn::Zero(di), di, P.nx + i), hn::Store(hn::Zero(di), di, P.ny + i);
+            continue;
+        }
         // Camera::project: (px + f·x/z, py − f·y/z).
         const V cx = hn::Add(px, hn::Div(hn::Mul(f, x), z)), cy = hn::Sub(py, hn::Div(hn::Mul(f, y), z));
         // pointFilterVariance(h·f/z) + spread: (V_h + (s_g·spacing)²) + spread, rounded to float.
