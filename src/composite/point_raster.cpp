@@ -94,14 +94,97 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTargets* slabs, const Sla
     }
 }
 
+#if HWY_TARGET != HWY_SCALAR
+constexpr int kPairLanes = 16;  // DrawPointPairs: two rows of 8 pixels per vector (16-lane targets)
+
+/// DrawPointFor on a 16-lane target, two rows a vector: a point's part in a tile is at most
+/// kPointMaxSide ≤ 8 columns wide, so a window of 8 columns from its first (moved left to stay in
+/// the row) holds it, and rows y and y + 1 share one vector (lower half row y, upper half y + 1),
+/// where one vector per row left half its lanes or more idle. The window's columns and the rows get
+/// their squared offsets and weights in one vector (lanes 0–7 the columns, 8–15 the rows: one pair
+/// of gathers, as DrawPointFor); every pixel then takes DrawPointFor's operations, so the same sums
+/// bit for bit.
+template <bool kSlabs, class D>
+void DrawPointPairs(D d, const PointRaster& p, const SlabTargets* slabs, const SlabTile* tile, const float* T, int tileX0,
+                    int tileY0) {
+    using V = hn::Vec<D>;
+    const hn::Half<D> dh;
+    const hn::RebindToSigned<D> di;
+    constexpr int kHalf = kPairLanes / 2;
+    const PointFilterTable& table = *p.table;
+    const int start = std::min(p.x0 - tileX0, kStride - kHalf);  // the window's first column in the tile
+    alignas(64) float sq[kPairLanes], g[kPairLanes];
+    {
+        const auto lane = hn::Iota(di, 0);
+        const auto isX = hn::Lt(lane, hn::Set(di, kHalf));
+        const auto pixel = hn::IfThenElse(isX, hn::Add(lane, hn::Set(di, tileX0 + start)), hn::Add(lane, hn::Set(di, p.y0 - kHalf)));
+        const auto centre = hn::IfThenElse(hn::RebindMask(d, isX), hn::Set(d, p.cx), hn::Set(d, p.cy));
+        const auto off = hn::Sub(hn::Add(hn::ConvertTo(d, pixel), hn::Set(d, 0.5f)), centre);
+        const auto off2 = hn::Mul(off, off);
+        hn::Store(off2, d, sq);
+        hn::Store(PointWeight(d, table, hn::Mul(off2, hn::Set(d, p.invVariance))), d, g);
+    }
+    const V dx2 = hn::Combine(d, hn::Load(dh, sq), hn::Load(dh, sq)), gx = hn::Combine(d, hn::Load(dh, g), hn::Load(dh, g));
+    const V eps = hn::Set(d, p.epsilon), rs2 = hn::Set(d, p.radius2), total = hn::Set(d, p.total), norm = hn::Set(d, p.norm);
+    const V cr = hn::Set(d, p.color.x), cg = hn::Set(d, p.color.y), cb = hn::Set(d, p.color.z);
+    // The footprint's columns, in each half.
+    const auto column = hn::Add(hn::Set(di, tileX0 + start), hn::Combine(di, hn::Iota(hn::Half<decltype(di)>(), 0), hn::Iota(hn::Half<decltype(di)>(), 0)));
+    const auto columns = hn::RebindMask(d, hn::And(hn::Gt(column, hn::Set(di, p.x0 - 1)), hn::Lt(column, hn::Set(di, p.x1 + 1))));
+    const auto lowerHalf = hn::FirstN(d, size_t(kHalf));
+    for (int y = p.y0; y <= p.y1; y += 2) {
+        const bool pair = y < p.y1;  // else a lone last row: its upper half repeats it, masked off
+        const int ka = y - p.y0, kb = pair ? ka + 1 : ka;
+        const int offA = (y - tileY0) * kStride + start, offB = pair ? offA + kStride : offA;
+        const auto both = [&](const float* a) { return hn::Combine(d, hn::Set(dh, a[kHalf + kb]), hn::Set(dh, a[kHalf + ka])); };
+        const V dy2 = both(sq), gy = both(g);
+        const auto load = [&](const float* base) { return hn::Combine(d, hn::LoadU(dh, base + offB), hn::LoadU(dh, base + offA)); };
+        const auto mask = hn::And(hn::And(pair ? columns : hn::And(columns, lowerHalf), hn::Ge(load(T), eps)),
+                                  hn::Lt(hn::Add(dx2, dy2), rs2));
+        if (hn::AllFalse(d, mask)) continue;
+        const V tauAll = hn::Mul(total, hn::Mul(hn::Mul(gx, gy), norm));
+        const auto deposit = [&](V tau, float* sumTau, float* sumR, float* sumG, float* sumB) {
+            const auto store = [&](float* base, V value) {
+                hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
+                if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
+            };
+            const V t0 = load(sumTau), r0 = load(sumR), g0 = load(sumG), b0 = load(sumB);
+            store(sumTau, hn::IfThenElse(mask, hn::Add(t0, tau), t0));
+            store(sumR, hn::IfThenElse(mask, hn::Add(r0, hn::Mul(tau, cr)), r0));
+            store(sumG, hn::IfThenElse(mask, hn::Add(g0, hn::Mul(tau, cg)), g0));
+            store(sumB, hn::IfThenElse(mask, hn::Add(b0, hn::Mul(tau, cb)), b0));
+        };
+        if constexpr (kSlabs) {
+            for (int j = 0; j < slabs->count; ++j)
+                deposit(hn::Mul(tauAll, hn::Set(d, slabs->fraction[size_t(j)])), slabs->tau[size_t(j)], slabs->er[size_t(j)],
+                        slabs->eg[size_t(j)], slabs->eb[size_t(j)]);
+        } else {
+            deposit(tauAll, tile->tau, tile->er, tile->eg, tile->eb);
+        }
+    }
+}
+#endif  // HWY_TARGET != HWY_SCALAR
+
+/// The point's pixels in the tile: two rows a vector where vectors hold 16 floats, else one row.
+template <bool kSlabs>
+void DrawPointIn(const PointRaster& p, const SlabTargets* slabs, const SlabTile* tile, const float* T, int x0, int y0) {
+#if HWY_TARGET != HWY_SCALAR
+    using D16 = hn::CappedTag<float, kPairLanes>;
+    if constexpr (hn::MaxLanes(D16()) == kPairLanes) {
+        static_assert(kPointMaxSide <= kPairLanes / 2, "a point's columns fit half a vector");
+        if (hn::Lanes(D16()) == kPairLanes) return DrawPointPairs<kSlabs>(D16(), p, slabs, tile, T, x0, y0);
+    }
+#endif
+    DrawPointFor<kSlabs>(hn::CappedTag<float, kStride>(), p, slabs, tile, T, x0, y0);
+}
+
 void DrawPoint(const PointRaster& p, const SlabTile& tile) {
     if (p.x0 > p.x1 || p.y0 > p.y1) return;
-    DrawPointFor<false>(hn::CappedTag<float, kStride>(), p, nullptr, &tile, tile.T, tile.x0, tile.y0);
+    DrawPointIn<false>(p, nullptr, &tile, tile.T, tile.x0, tile.y0);
 }
 
 void DrawPointSlabs(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0) {
     if (p.x0 > p.x1 || p.y0 > p.y1) return;
-    DrawPointFor<true>(hn::CappedTag<float, kStride>(), p, &slabs, nullptr, T, x0, y0);
+    DrawPointIn<true>(p, &slabs, nullptr, T, x0, y0);
 }
 
 }  // namespace HWY_NAMESPACE
