@@ -184,12 +184,13 @@ void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const VoxelBatc
 }  // namespace
 
 std::optional<PointLaneContext> pointLaneContext(const ProjectionContext& ctx) {
-    if (!ctx.vector || (ctx.shape && !ctx.shape->sphere) || ctx.mode != RenderMode::Hybrid) return std::nullopt;
+    const bool pointsOnly = ctx.mode == RenderMode::Point;
+    if (!ctx.vector || (ctx.shape && !ctx.shape->sphere) || !(ctx.mode == RenderMode::Hybrid || pointsOnly)) return std::nullopt;
     PointLaneContext lanes;
     lanes.focal = ctx.camera.focal();
     lanes.principalX = ctx.camera.principal().x, lanes.principalY = ctx.camera.principal().y;
     lanes.spacingTimesFocal = ctx.voxelSize * ctx.camera.focal();
-    lanes.threshold = ctx.threshold;
+    lanes.threshold = pointsOnly ? INFINITY : ctx.threshold;  // point mode: every voxel in front of the eye
     lanes.voxelSize = ctx.voxelSize;
     lanes.prefilterVariance = ctx.prefilterVariance;
     lanes.kernelSigma = ctx.tables.kernel->sigma();
@@ -259,8 +260,8 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
     window.profiles = ctx.slabs.on;
     window.resize(batch.size());
     const std::optional<SplatLaneContext> laneContext = splatLaneContext(ctx);
-    // Points in lanes too where the splats are (hybrid): the far views' and the clouds' voxels.
-    const std::optional<PointLaneContext> pointContext = laneContext ? pointLaneContext(ctx) : std::nullopt;
+    // Points in lanes too (hybrid and point mode): the far views' and the clouds' voxels.
+    const std::optional<PointLaneContext> pointContext = pointLaneContext(ctx);
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, batch.size(), 1024), ProjectionCounts{},
         [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
@@ -273,13 +274,13 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                     chunk = i, chunkEnd = std::min(r.end(), i + kSplatLanes);
                     slabsOf(batch.distance.data() + chunk, chunkEnd - chunk, ctx.slabLength, batch.slabBegin,
                             batch.slabEnd - 1, slabs.data());
-                    if (laneContext) {
+                    if (laneContext || pointContext) {
                         for (size_t k = chunk; k < chunkEnd; ++k) {
                             lanes.x[k - chunk] = batch.viewPos[k].x, lanes.y[k - chunk] = batch.viewPos[k].y;
                             lanes.z[k - chunk] = batch.viewPos[k].z;
                         }
                         for (size_t k = chunkEnd - chunk; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
-                        projectSplatsVector(lanes, chunkEnd - chunk, *laneContext);
+                        if (laneContext) projectSplatsVector(lanes, chunkEnd - chunk, *laneContext);
                         if (pointContext) {
                             const size_t n = chunkEnd - chunk;
                             std::copy_n(batch.sigma.data() + chunk, n, points.sigma);

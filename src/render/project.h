@@ -77,9 +77,9 @@ struct ProjectionCounts {
 /// voxel takes projectVoxel. projectBatch projects through it, lanes it declines through projectVoxel.
 std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx);
 
-/// @brief What projectPointsVector needs of @p ctx, where it applies: sphere kernels in hybrid,
-/// --simd on. projectBatch uses it beside splatLaneContext (only where that applies too): the
-/// lanes the splats leave that are points take it, the rest projectVoxel.
+/// @brief What projectPointsVector needs of @p ctx, where it applies: sphere kernels in hybrid or
+/// point mode, --simd on. projectBatch uses it beside splatLaneContext: the lanes the splats leave
+/// that are points take it, the rest projectVoxel.
 std::optional<PointLaneContext> pointLaneContext(const ProjectionContext& ctx);
 
 /// @brief Projects every voxel of @p batch into @p window (grown when needed, never shrunk: it

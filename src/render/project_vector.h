@@ -70,12 +70,12 @@ void projectSplatsVector(SplatLanes& lanes, size_t n, const SplatLaneContext& ct
 
 class PointFilterTable;
 
-/// What every point lane shares (hybrid, sphere kernels; from ProjectionContext).
+/// What every point lane shares (hybrid or point mode, sphere kernels; from ProjectionContext).
 struct PointLaneContext {
     double focal = 1.0;                  ///< f (pixels)
     double principalX = 0.0, principalY = 0.0;
     double spacingTimesFocal = 0.0;      ///< h·f: the projected spacing is h·f/z
-    double threshold = 0.0;              ///< a point where h·f/z < threshold
+    double threshold = 0.0;              ///< a point where h·f/z < threshold (point mode: +∞)
     double voxelSize = 1.0;              ///< h (world units)
     double prefilterVariance = 0.0;      ///< V_h folded into each point (px²)
     double kernelSigma = 1.0;            ///< s_g (voxels)
@@ -85,7 +85,7 @@ struct PointLaneContext {
 
 /// The minified voxels of one call (DESIGN §4), structure of arrays: makePoint's point and
 /// setUpPointFilter's filter for every lane the splat lanes left to the scalar path that is a
-/// point in hybrid (z > 0, h·f/z < threshold, finite). In: sigma (per voxel length) and spread
+/// point (z > 0, h·f/z < threshold, finite; point mode's threshold is +∞). In: sigma (per voxel length) and spread
 /// (an aggregate's, px²) per lane, the positions from SplatLanes. Out, per lane: `status` kPoint
 /// and the record's fields, or kScalar: the scalar path decides (not a point, or a case it
 /// keeps: a point makePoint culls, the one-pixel fallback of an empty filter sum).
@@ -106,8 +106,8 @@ struct PointLanes {
     }
 };
 
-/// @brief The points among lanes [0, @p n) of @p in (after projectSplatsVector: only its kScalar
-/// lanes are looked at), into @p out (sigma and spread set): makePoint and setUpPointFilter's
+/// @brief The points among lanes [0, @p n) of @p in (x, y, z set; a lane projectSplatsVector took
+/// is no point), into @p out (sigma and spread set): makePoint and setUpPointFilter's
 /// double and float operations in the same order, so the same record bit for bit (the scalar
 /// path is the oracle; tests/render/test_project_vector.cpp), 16 points' filter sums at once.
 void projectPointsVector(const SplatLanes& in, PointLanes& out, size_t n, const PointLaneContext& ctx);

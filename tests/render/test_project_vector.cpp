@@ -130,9 +130,10 @@ TEST(ProjectVector, LanesEqualTheScalarProjection) {
 /// minified voxel makePoint keeps must be taken (culled points and the one-pixel fallback of an
 /// empty filter sum are the scalar path's).
 void checkPointLanes(const ProjectionContext& ctx, const std::vector<glm::vec3>& voxels, Coverage& cov) {
-    const std::optional<SplatLaneContext> lc = splatLaneContext(ctx);
+    const std::optional<SplatLaneContext> lc = splatLaneContext(ctx);  // none in point mode
     const std::optional<PointLaneContext> pc = pointLaneContext(ctx);
-    ASSERT_TRUE(lc.has_value() && pc.has_value());
+    ASSERT_TRUE(pc.has_value());
+    ASSERT_EQ(lc.has_value(), ctx.mode == RenderMode::Hybrid);
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     SplatLanes lanes;
@@ -148,13 +149,14 @@ void checkPointLanes(const ProjectionContext& ctx, const std::vector<glm::vec3>&
             points.sigma[k] = k >= n ? 0.f : r < 0.05f ? 0.f : r < 0.1f ? 1e-44f : 0.05f + 3.f * u(rng);
             points.spread[k] = k >= n || u(rng) < 0.5f ? 0.f : 2.f * u(rng);
         }
-        projectSplatsVector(lanes, n, *lc);
+        if (lc) projectSplatsVector(lanes, n, *lc);
+        else std::fill(std::begin(lanes.status), std::end(lanes.status), SplatLanes::kScalar);
         projectPointsVector(lanes, points, n, *pc);
         for (size_t k = 0; k < n; ++k) {
             const glm::vec3 c = voxels[begin + k];
             const Primitive q = projectVoxel(glm::dvec3(c), points.sigma[k], glm::vec3(0.2f, 0.5f, 0.9f), ctx, points.spread[k]);
             const bool point = std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && c.z > 0.f &&
-                               ctx.voxelSize * ctx.camera.focal() / double(c.z) < ctx.threshold;
+                               (ctx.mode == RenderMode::Point || ctx.voxelSize * ctx.camera.focal() / double(c.z) < ctx.threshold);
             const uint8_t status = points.status[k];
             SCOPED_TRACE("voxel " + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z));
             if (!point) {
@@ -193,10 +195,11 @@ TEST(ProjectVector, PointLanesEqualTheScalarProjection) {
     const std::vector<glm::vec3> voxels = testVoxels();
     // Thresholds that make the far third of the voxels points, and most of them; the low-pass
     // as the prefilter order's, the postfilter's small one, and none (the filter of the voxel alone).
-    for (const double threshold : {1.0, 4.0})
+    for (const double threshold : {1.0, 4.0, 0.0})  // 0: point mode (every voxel in front of the eye)
         for (const double prefilter : {kPrefilterVariance, 0.1, 0.0}) {
-            ProjectionContext ctx{camera, tables(), 0.1, 0.1, RenderMode::Hybrid, threshold, FootprintPath::Auto, false, prefilter};
-            SCOPED_TRACE("threshold " + std::to_string(threshold) + " prefilter " + std::to_string(prefilter));
+            const RenderMode mode = threshold > 0.0 ? RenderMode::Hybrid : RenderMode::Point;
+            ProjectionContext ctx{camera, tables(), 0.1, 0.1, mode, threshold, FootprintPath::Auto, false, prefilter};
+            SCOPED_TRACE(toString(mode) + " threshold " + std::to_string(threshold) + " prefilter " + std::to_string(prefilter));
             test::forEachTarget([&] {
                 Coverage cov;  // splats: points taken; offImage: culled points; exact: fallbacks; declined: not points
                 checkPointLanes(ctx, voxels, cov);
@@ -207,15 +210,17 @@ TEST(ProjectVector, PointLanesEqualTheScalarProjection) {
         }
 }
 
-// The points' lanes serve hybrid only, sphere kernels, --simd on.
-TEST(ProjectVector, PointLanesServeHybridWithSimd) {
+// The points' lanes serve hybrid and point mode, sphere kernels, --simd on.
+TEST(ProjectVector, PointLanesServeHybridAndPointModeWithSimd) {
     const Camera camera = testCamera(64);
     ProjectionContext ctx{camera, tables(), 0.1, 0.1, RenderMode::Hybrid, 1.0, FootprintPath::Auto, false};
+    EXPECT_TRUE(pointLaneContext(ctx).has_value());
+    ctx.mode = RenderMode::Point;
     EXPECT_TRUE(pointLaneContext(ctx).has_value());
     ctx.vector = false;
     EXPECT_FALSE(pointLaneContext(ctx).has_value());
     ctx.vector = true;
-    for (const RenderMode mode : {RenderMode::Point, RenderMode::Splat, RenderMode::Ewa, RenderMode::Swan, RenderMode::None}) {
+    for (const RenderMode mode : {RenderMode::Splat, RenderMode::Ewa, RenderMode::Swan, RenderMode::None}) {
         ctx.mode = mode;
         EXPECT_FALSE(pointLaneContext(ctx).has_value()) << toString(mode);
     }
@@ -238,7 +243,7 @@ TEST(ProjectVector, OnlyServesSphereSplatsWithSimd) {
     EXPECT_FALSE(splatLaneContext(ctx).has_value());
 }
 
-// projectBatch with the lanes and without (--simd off) fills the same window.
+// projectBatch with the lanes and without (--simd off) fills the same window, in hybrid and point mode.
 TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
     const Camera camera = testCamera(64);
     const std::vector<glm::vec3> voxels = testVoxels();
@@ -252,37 +257,40 @@ TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
         batch.members.push_back(1 + uint32_t(i % 4));
     }
     batch.slabBegin = 0, batch.slabEnd = 1000;
-    ProjectionContext ctx{camera, tables(), 0.1, 0.1, RenderMode::Hybrid, 1.0, FootprintPath::Auto, false};
-    ProjectedWindow lanes, scalar;
-    const ProjectionCounts a = projectBatch(batch, ctx, lanes);
-    ctx.vector = false;
-    const ProjectionCounts b = projectBatch(batch, ctx, scalar);
-    EXPECT_EQ(a.points, b.points);
-    EXPECT_EQ(a.splats, b.splats);
-    EXPECT_EQ(a.exactIndexSplats, b.exactIndexSplats);
-    EXPECT_EQ(a.drawnVoxels, b.drawnVoxels);
-    EXPECT_EQ(a.lodAggregates, b.lodAggregates);
-    EXPECT_GT(a.points, 1000);  // both lane paths are exercised
-    EXPECT_GT(a.splats, 1000);
-    ASSERT_EQ(lanes.size, scalar.size);
-    for (size_t i = 0; i < lanes.size; ++i) {
-        ASSERT_EQ(lanes.order[i], scalar.order[i]) << i;
-        if (lanes.order[i] == ProjectedWindow::kNotDrawn) continue;
-        const PrimitiveRecord &p = lanes.records[i], &q = scalar.records[i];
-        ASSERT_EQ(p.kind, q.kind) << i;
-        ASSERT_EQ(p.centre, q.centre) << i;
-        ASSERT_EQ(p.shape, q.shape) << i;
-        ASSERT_EQ(p.scale, q.scale) << i;
-        ASSERT_EQ(p.color, q.color) << i;
-        ASSERT_EQ(p.sin2Alpha, q.sin2Alpha) << i;
-        ASSERT_EQ(p.slab, q.slab) << i;
-        ASSERT_TRUE(p.range.x0 == q.range.x0 && p.range.y0 == q.range.y0 && p.range.x1 == q.range.x1 &&
-                    p.range.y1 == q.range.y1) << i;
-        ASSERT_EQ(lanes.tiles[i], scalar.tiles[i]) << i;
-        ASSERT_EQ(lanes.depth[i], scalar.depth[i]) << i;
-        ASSERT_EQ(lanes.members[i], scalar.members[i]) << i;
-        if (p.hasExactMap) {
-            ASSERT_EQ(lanes.extra[i].exactMap.A, scalar.extra[i].exactMap.A) << i;
+    for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Point}) {
+        SCOPED_TRACE(toString(mode));
+        ProjectionContext ctx{camera, tables(), 0.1, 0.1, mode, 1.0, FootprintPath::Auto, false};
+        ProjectedWindow lanes, scalar;
+        const ProjectionCounts a = projectBatch(batch, ctx, lanes);
+        ctx.vector = false;
+        const ProjectionCounts b = projectBatch(batch, ctx, scalar);
+        EXPECT_EQ(a.points, b.points);
+        EXPECT_EQ(a.splats, b.splats);
+        EXPECT_EQ(a.exactIndexSplats, b.exactIndexSplats);
+        EXPECT_EQ(a.drawnVoxels, b.drawnVoxels);
+        EXPECT_EQ(a.lodAggregates, b.lodAggregates);
+        EXPECT_GT(a.points, 1000);  // both lane paths are exercised (point mode: points alone)
+        if (mode == RenderMode::Hybrid) EXPECT_GT(a.splats, 1000);
+        ASSERT_EQ(lanes.size, scalar.size);
+        for (size_t i = 0; i < lanes.size; ++i) {
+            ASSERT_EQ(lanes.order[i], scalar.order[i]) << i;
+            if (lanes.order[i] == ProjectedWindow::kNotDrawn) continue;
+            const PrimitiveRecord &p = lanes.records[i], &q = scalar.records[i];
+            ASSERT_EQ(p.kind, q.kind) << i;
+            ASSERT_EQ(p.centre, q.centre) << i;
+            ASSERT_EQ(p.shape, q.shape) << i;
+            ASSERT_EQ(p.scale, q.scale) << i;
+            ASSERT_EQ(p.color, q.color) << i;
+            ASSERT_EQ(p.sin2Alpha, q.sin2Alpha) << i;
+            ASSERT_EQ(p.slab, q.slab) << i;
+            ASSERT_TRUE(p.range.x0 == q.range.x0 && p.range.y0 == q.range.y0 && p.range.x1 == q.range.x1 &&
+                        p.range.y1 == q.range.y1) << i;
+            ASSERT_EQ(lanes.tiles[i], scalar.tiles[i]) << i;
+            ASSERT_EQ(lanes.depth[i], scalar.depth[i]) << i;
+            ASSERT_EQ(lanes.members[i], scalar.members[i]) << i;
+            if (p.hasExactMap) {
+                ASSERT_EQ(lanes.extra[i].exactMap.A, scalar.extra[i].exactMap.A) << i;
+            }
         }
     }
 }
