@@ -181,6 +181,25 @@ void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const VoxelBatc
     window.place(i, slab, batch.distance[i], batch.members[i]);
 }
 
+/// Voxels [@p first, @p first + @p n) of @p batch (n ≤ kSplatLanes) into the lanes, and projected
+/// there as splats and as points where those contexts apply; the lanes past n hold zeros.
+void projectChunkInLanes(const VoxelBatch& batch, size_t first, size_t n, const std::optional<SplatLaneContext>& splats,
+                         const std::optional<PointLaneContext>& pointsIn, SplatLanes& lanes, PointLanes& points) {
+    if (!splats && !pointsIn) return;
+    for (size_t k = 0; k < n; ++k) {
+        const glm::vec3& c = batch.viewPos[first + k];
+        lanes.x[k] = c.x, lanes.y[k] = c.y, lanes.z[k] = c.z;
+    }
+    for (size_t k = n; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
+    if (splats) projectSplatsVector(lanes, n, *splats);
+    if (!pointsIn) return;
+    std::copy_n(batch.sigma.data() + first, n, points.sigma);
+    std::copy_n(batch.spread.data() + first, n, points.spread);
+    std::fill(points.sigma + n, points.sigma + kSplatLanes, 0.f);
+    std::fill(points.spread + n, points.spread + kSplatLanes, 0.f);
+    projectPointsVector(lanes, points, n, *pointsIn);
+}
+
 }  // namespace
 
 std::optional<PointLaneContext> pointLaneContext(const ProjectionContext& ctx) {
@@ -274,22 +293,7 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                     chunk = i, chunkEnd = std::min(r.end(), i + kSplatLanes);
                     slabsOf(batch.distance.data() + chunk, chunkEnd - chunk, ctx.slabLength, batch.slabBegin,
                             batch.slabEnd - 1, slabs.data());
-                    if (laneContext || pointContext) {
-                        for (size_t k = chunk; k < chunkEnd; ++k) {
-                            lanes.x[k - chunk] = batch.viewPos[k].x, lanes.y[k - chunk] = batch.viewPos[k].y;
-                            lanes.z[k - chunk] = batch.viewPos[k].z;
-                        }
-                        for (size_t k = chunkEnd - chunk; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
-                        if (laneContext) projectSplatsVector(lanes, chunkEnd - chunk, *laneContext);
-                        if (pointContext) {
-                            const size_t n = chunkEnd - chunk;
-                            std::copy_n(batch.sigma.data() + chunk, n, points.sigma);
-                            std::copy_n(batch.spread.data() + chunk, n, points.spread);
-                            std::fill(points.sigma + n, points.sigma + kSplatLanes, 0.f);
-                            std::fill(points.spread + n, points.spread + kSplatLanes, 0.f);
-                            projectPointsVector(lanes, points, n, *pointContext);
-                        }
-                    }
+                    projectChunkInLanes(batch, chunk, chunkEnd - chunk, laneContext, pointContext, lanes, points);
                 }
                 const int64_t slab = slabs[i - chunk];  // clamp(⌊distance / slabLength⌋, the batch's slabs)
                 PrimitiveKind kind;
