@@ -133,7 +133,7 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
 /// the float values the record keeps are stored in @p P. Lanes [0, m) are computed (m a whole
 /// number of float vectors; the caller zeroes the inputs past n).
 void PointBoxes(const SplatLanes& L, PointLanes& P, size_t m, const PointLaneContext& ctx) {
-    const hn::ScalableTag<double> d;
+    const hn::CappedTag<double, 8> d;  // at most 8 lanes: a whole number of them in m on every target
     const hn::Rebind<float, decltype(d)> df;
     const hn::Rebind<int32_t, decltype(d)> di;
     using V = hn::Vec<decltype(d)>;
@@ -224,7 +224,7 @@ void PointBoxes(const SplatLanes& L, PointLanes& P, size_t m, const PointLaneCon
 /// pixel outside the circle, a row past ny or a column past nx adding +0), then the columns
 /// pairwise (sumColumnsPairwise). Stores 1/sum as the norm, and the sum.
 void PointSums(PointLanes& P, size_t m, const PointFilterTable& table, float* sums) {
-    const hn::ScalableTag<float> d;
+    const hn::CappedTag<float, 16> d;  // at most 16 lanes: a whole number of them in m
     const hn::RebindToSigned<decltype(d)> di;
     using V = hn::Vec<decltype(d)>;
     const size_t N = hn::Lanes(d);
@@ -262,8 +262,8 @@ void PointSums(PointLanes& P, size_t m, const PointFilterTable& table, float* su
 }
 
 void ProjectPoints(const SplatLanes& L, PointLanes& P, size_t n, const PointLaneContext& ctx) {
-    constexpr size_t kVector = 16;  // a whole number of float vectors on every target (≤ 16 lanes)
-    static_assert(kSplatLanes % kVector == 0 && hn::MaxLanes(hn::ScalableTag<float>()) <= kVector);
+    constexpr size_t kVector = 16;  // PointSums' widest vector (and twice PointBoxes'): m is a whole number of them
+    static_assert(kSplatLanes % kVector == 0);
     const size_t m = (n + kVector - 1) / kVector * kVector;
     PointBoxes(L, P, m, ctx);
     bool any = false;
