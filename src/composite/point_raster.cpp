@@ -37,21 +37,7 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTargets* slabs, const Sla
     // squared offset and its weight, both axes in one vector of 16 (lanes 0–7 the columns from
     // p.x0, 8–15 the rows from p.y0: one pair of gathers), then put on the tile's lanes.
     alignas(64) float sq[16], g[16];
-    {
-        const hn::CappedTag<float, 16> d16;
-        const hn::RebindToSigned<decltype(d16)> di16;
-        constexpr int N16 = int(hn::MaxLanes(d16));
-        for (int k = 0; k < 16; k += N16) {
-            const auto lane = hn::Iota(di16, k);
-            const auto isX = hn::Lt(lane, hn::Set(di16, 8));
-            const auto pixel = hn::IfThenElse(isX, hn::Add(lane, hn::Set(di16, p.x0)), hn::Add(lane, hn::Set(di16, p.y0 - 8)));
-            const auto centre = hn::IfThenElse(hn::RebindMask(d16, isX), hn::Set(d16, p.cx), hn::Set(d16, p.cy));
-            const auto off = hn::Sub(hn::Add(hn::ConvertTo(d16, pixel), hn::Set(d16, 0.5f)), centre);
-            const auto off2 = hn::Mul(off, off);
-            hn::Store(off2, d16, sq + k);
-            hn::Store(PointWeight(d16, table, hn::Mul(off2, hn::Set(d16, p.invVariance))), d16, g + k);
-        }
-    }
+    AxisWeights(table, p.x0, p.y0, p.cx, p.cy, p.invVariance, sq, g);
     // The columns on the tile's lanes: lanes past the footprint's part hold other columns' values
     // (or zeros), masked off below.
     alignas(64) float dx2s[kStride + 8] = {}, gxs[kStride + 8] = {};
@@ -101,9 +87,8 @@ constexpr int kPairLanes = 16;  // DrawPointPairs: two rows of 8 pixels per vect
 /// kPointMaxSide ≤ 8 columns wide, so a window of 8 columns from its first (moved left to stay in
 /// the row) holds it, and rows y and y + 1 share one vector (lower half row y, upper half y + 1),
 /// where one vector per row left half its lanes or more idle. The window's columns and the rows get
-/// their squared offsets and weights in one vector (lanes 0–7 the columns, 8–15 the rows: one pair
-/// of gathers, as DrawPointFor); every pixel then takes DrawPointFor's operations, so the same sums
-/// bit for bit.
+/// their squared offsets and weights from AxisWeights, as DrawPointFor's; every pixel then takes
+/// DrawPointFor's operations, so the same sums bit for bit.
 template <bool kSlabs, class D>
 void DrawPointPairs(D d, const PointRaster& p, const SlabTargets* slabs, const SlabTile* tile, const float* T, int tileX0,
                     int tileY0) {
@@ -113,17 +98,8 @@ void DrawPointPairs(D d, const PointRaster& p, const SlabTargets* slabs, const S
     constexpr int kHalf = kPairLanes / 2;
     const PointFilterTable& table = *p.table;
     const int start = std::min(p.x0 - tileX0, kStride - kHalf);  // the window's first column in the tile
-    alignas(64) float sq[kPairLanes], g[kPairLanes];
-    {
-        const auto lane = hn::Iota(di, 0);
-        const auto isX = hn::Lt(lane, hn::Set(di, kHalf));
-        const auto pixel = hn::IfThenElse(isX, hn::Add(lane, hn::Set(di, tileX0 + start)), hn::Add(lane, hn::Set(di, p.y0 - kHalf)));
-        const auto centre = hn::IfThenElse(hn::RebindMask(d, isX), hn::Set(d, p.cx), hn::Set(d, p.cy));
-        const auto off = hn::Sub(hn::Add(hn::ConvertTo(d, pixel), hn::Set(d, 0.5f)), centre);
-        const auto off2 = hn::Mul(off, off);
-        hn::Store(off2, d, sq);
-        hn::Store(PointWeight(d, table, hn::Mul(off2, hn::Set(d, p.invVariance))), d, g);
-    }
+    alignas(64) float sq[kPairLanes], g[kPairLanes];  // lanes 0–7 the window's columns, 8–15 the rows
+    AxisWeights(table, tileX0 + start, p.y0, p.cx, p.cy, p.invVariance, sq, g);
     const V dx2 = hn::Combine(d, hn::Load(dh, sq), hn::Load(dh, sq)), gx = hn::Combine(d, hn::Load(dh, g), hn::Load(dh, g));
     const V eps = hn::Set(d, p.epsilon), rs2 = hn::Set(d, p.radius2), total = hn::Set(d, p.total), norm = hn::Set(d, p.norm);
     const V cr = hn::Set(d, p.color.x), cg = hn::Set(d, p.color.y), cb = hn::Set(d, p.color.z);

@@ -21,22 +21,9 @@ PointSetup SetupPoint(const PointFilterTable& table, const PixelCoord& x, double
     PointSetup s;
     float invV = 0.0f, rs2 = 0.0f;
     if (!pointSetupBox(x, variance, s, invV, rs2)) return s;
-    // Lanes 0–7: the columns' offsets; 8–15: the rows'. (i + ½) − c in float: one rounding of
-    // the exact difference, as setupPoint's double difference rounded to float is for a float c.
-    const hn::CappedTag<float, 16> d;
-    const hn::RebindToSigned<decltype(d)> di;
-    constexpr int N = int(hn::MaxLanes(d));
+    // Lanes 0–7: the columns' squared offsets and weights; 8–15: the rows'.
     alignas(64) float sq[16], g[16];
-    for (int k = 0; k < 16; k += N) {
-        const auto lane = hn::Iota(di, k);
-        const auto isX = hn::Lt(lane, hn::Set(di, 8));
-        const auto index = hn::IfThenElse(isX, hn::Add(lane, hn::Set(di, s.x0)), hn::Add(lane, hn::Set(di, s.y0 - 8)));
-        const auto centre = hn::IfThenElse(hn::RebindMask(d, isX), hn::Set(d, float(x.x)), hn::Set(d, float(x.y)));
-        const auto off = hn::Sub(hn::Add(hn::ConvertTo(d, index), hn::Set(d, 0.5f)), centre);
-        const auto off2 = hn::Mul(off, off);
-        hn::Store(off2, d, sq + k);
-        hn::Store(PointWeight(d, table, hn::Mul(off2, hn::Set(d, invV))), d, g + k);
-    }
+    AxisWeights(table, s.x0, s.y0, float(x.x), float(x.y), invV, sq, g);
     // Each column's sum down the rows in a lane (0 outside the circle and past nx; adding +0
     // changes no sum), then the columns pairwise: sumColumnsPairwise's order, as setupPoint's.
     const hn::CappedTag<float, kPointSumColumns> d8;

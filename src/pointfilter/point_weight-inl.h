@@ -32,6 +32,30 @@ HWY_INLINE V PointWeight(D d, const PointFilterTable& table, V x) {
     return hn::IfThenElseZero(valid, hn::Add(v0, hn::Mul(w, hn::Sub(v1, v0))));
 }
 
+/// A point's eight columns from pixel @p firstX and eight rows from @p firstY, in one set of 16
+/// lanes (lanes 0–7 the columns, 8–15 the rows: one pair of gathers for a 16-lane target): each
+/// pixel centre's squared offset from the point's centre (@p cx, @p cy), (i + ½) − c in float (one
+/// rounding of the exact difference, as the scalar setup's double difference rounded to float is),
+/// into @p sq, and its weight PointWeight(offset² / V) into @p g. The point setup and the point
+/// loops share it, so their weights are the same floats.
+HWY_INLINE void AxisWeights(const PointFilterTable& table, int firstX, int firstY, float cx, float cy, float invVariance,
+                            float* HWY_RESTRICT sq, float* HWY_RESTRICT g) {
+    namespace hn = hwy::HWY_NAMESPACE;
+    const hn::CappedTag<float, 16> d;
+    const hn::RebindToSigned<decltype(d)> di;
+    constexpr int N = int(hn::MaxLanes(d));
+    for (int k = 0; k < 16; k += N) {
+        const auto lane = hn::Iota(di, k);
+        const auto isX = hn::Lt(lane, hn::Set(di, 8));
+        const auto pixel = hn::IfThenElse(isX, hn::Add(lane, hn::Set(di, firstX)), hn::Add(lane, hn::Set(di, firstY - 8)));
+        const auto centre = hn::IfThenElse(hn::RebindMask(d, isX), hn::Set(d, cx), hn::Set(d, cy));
+        const auto off = hn::Sub(hn::Add(hn::ConvertTo(d, pixel), hn::Set(d, 0.5f)), centre);
+        const auto off2 = hn::Mul(off, off);
+        hn::Store(off2, d, sq + k);
+        hn::Store(PointWeight(d, table, hn::Mul(off2, hn::Set(d, invVariance))), d, g + k);
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace vdbsplat
 HWY_AFTER_NAMESPACE();

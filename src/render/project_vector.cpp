@@ -20,6 +20,23 @@ namespace vdbsplat {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
+/// pixelRange's rounding of a bound, vectors at a time: the first pixel of a low bound,
+/// ⌈clamp(lo − ½, 0, n)⌉, and the last of a high bound, ⌊clamp(hi − ½, −1, n − 1)⌋ (each a
+/// truncation and a compare, as the scalar clamps, casts and compares); @p size is n.
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V FirstPixel(D d, V lo, V size) {
+    const V t = hn::Min(hn::Max(hn::Sub(lo, hn::Set(d, 0.5)), hn::Zero(d)), size);
+    const V i = hn::Trunc(t);
+    return hn::IfThenElse(hn::Lt(i, t), hn::Add(i, hn::Set(d, 1.0)), i);
+}
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V LastPixel(D d, V hi, V size) {
+    const V one = hn::Set(d, 1.0);
+    const V t = hn::Min(hn::Max(hn::Sub(hi, hn::Set(d, 0.5)), hn::Neg(one)), hn::Sub(size, one));
+    const V i = hn::Trunc(t);
+    return hn::IfThenElse(hn::Gt(i, t), hn::Sub(i, one), i);
+}
+
 void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
     const hn::ScalableTag<double> d;
     using V = hn::Vec<decltype(d)>;
@@ -79,20 +96,9 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         const V aa = hn::Mul(aw, aw), bb = hn::Mul(bw, bw);
         const V hx = hn::Sqrt(hn::Add(hn::Mul(hn::Mul(aa, ux), ux), hn::Mul(hn::Mul(bb, vx), vx)));
         const V hy = hn::Sqrt(hn::Add(hn::Mul(hn::Mul(aa, uy), uy), hn::Mul(hn::Mul(bb, vy), vy)));
-        // pixelRange(bounds, W, H): first = ⌈clamp(lo − ½, 0, n)⌉, last = ⌊clamp(hi − ½, −1, n − 1)⌋
-        // (as a truncation and a compare).
-        const auto first = [&](V lo, V size) {
-            const V t = hn::Min(hn::Max(hn::Sub(lo, half), zero), size);
-            const V i = hn::Trunc(t);
-            return hn::IfThenElse(hn::Lt(i, t), hn::Add(i, one), i);
-        };
-        const auto last = [&](V hi, V size) {
-            const V t = hn::Min(hn::Max(hn::Sub(hi, half), hn::Neg(one)), hn::Sub(size, one));
-            const V i = hn::Trunc(t);
-            return hn::IfThenElse(hn::Gt(i, t), hn::Sub(i, one), i);
-        };
-        const V x0 = first(hn::Sub(cx, hx), width), y0 = first(hn::Sub(cy, hy), height);
-        const V x1 = last(hn::Add(cx, hx), width), y1 = last(hn::Add(cy, hy), height);
+        // pixelRange(bounds, W, H).
+        const V x0 = FirstPixel(d, hn::Sub(cx, hx), width), y0 = FirstPixel(d, hn::Sub(cy, hy), height);
+        const V x1 = LastPixel(d, hn::Add(cx, hx), width), y1 = LastPixel(d, hn::Add(cy, hy), height);
         const auto onImage = hn::And(hn::Ge(x1, x0), hn::Ge(y1, y0));  // else makeSplat culls it (no pixel)
         // affineIndexError: (ρ·r)/(z·√((D − r)(D + r))).
         const V error = hn::Div(hn::Mul(rho, r), hn::Mul(z, hn::Sqrt(hn::Mul(hn::Sub(D, r), hn::Add(D, r)))));
@@ -172,19 +178,9 @@ void PointBoxes(const SplatLanes& L, PointLanes& P, size_t m, const PointLaneCon
         const V length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(x, x), hn::Mul(y, y)), hn::Mul(z, z)));
         const V sigmaW = hn::Div(hn::PromoteTo(d, hn::Load(df, P.sigma + i)), h);
         const auto totalF = hn::DemoteTo(df, hn::Mul(hn::Mul(hn::Mul(hn::Mul(sigmaW, M), fz), fz), hn::Div(length, z)));
-        // pixelRange of the box centre ± kPointMaxRadiusPx (as ProjectSplats' first and last).
-        const auto first = [&](V lo, V size) {
-            const V t = hn::Min(hn::Max(hn::Sub(lo, half), zero), size);
-            const V k = hn::Trunc(t);
-            return hn::IfThenElse(hn::Lt(k, t), hn::Add(k, one), k);
-        };
-        const auto last = [&](V hi, V size) {
-            const V t = hn::Min(hn::Max(hn::Sub(hi, half), hn::Neg(one)), hn::Sub(size, one));
-            const V k = hn::Trunc(t);
-            return hn::IfThenElse(hn::Gt(k, t), hn::Sub(k, one), k);
-        };
-        const auto onImage = hn::And(hn::Ge(last(hn::Add(cx, maxRadius), width), first(hn::Sub(cx, maxRadius), width)),
-                                     hn::Ge(last(hn::Add(cy, maxRadius), height), first(hn::Sub(cy, maxRadius), height)));
+        // pixelRange of the box centre ± kPointMaxRadiusPx: not empty.
+        const auto onImage = hn::And(hn::Ge(LastPixel(d, hn::Add(cx, maxRadius), width), FirstPixel(d, hn::Sub(cx, maxRadius), width)),
+                                     hn::Ge(LastPixel(d, hn::Add(cy, maxRadius), height), FirstPixel(d, hn::Sub(cy, maxRadius), height)));
         const auto kept = hn::And(hn::And(hn::IsFinite(cx), hn::IsFinite(cy)),
                                   hn::And(onImage, hn::Gt(hn::PromoteTo(d, totalF), zero)));
         // setUpPointFilter from the float centre and variance: pointSetupBox's rs, box, 1/V, r_s².
