@@ -75,6 +75,9 @@ inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
 float linearToSrgb(float v);
 /// @brief Inverse of linearToSrgb.
 float srgbToLinear(float v);
+/// @brief The 8-bit code PNG output writes for linear @p v: lround(255·linearToSrgb(v)), by a
+/// table of the codes' thresholds (the same code for every float; 0 for NaN).
+uint8_t linearToSrgbCode(float v);
 
 /// @brief Writes @p image to @p path (.png or .exr, by extension) atomically.
 /// EXR files carry @p metadata as string attributes.

@@ -18,6 +18,8 @@
 #include <ImfStringAttribute.h>
 #include <png.h>
 
+#include <bit>
+#include <cmath>
 #include <filesystem>
 #include <functional>
 
@@ -127,6 +129,65 @@ TEST(Image, PngRoundTripsToTheEncodedSrgbValues) {
             EXPECT_FLOAT_EQ(b.pixels[i][c], srgbToLinear(encoded)) << i;
         }
     for (const glm::vec4& p : b.pixels) EXPECT_EQ(p.w, 1.0f);
+}
+
+/// The formula the PNG codes stand for: lround(255·linearToSrgb(v)) as a byte (NaN: 0).
+int srgbCodeByFormula(float v) { return int(static_cast<uint8_t>(std::lround(255.0f * linearToSrgb(v)))); }
+
+// linearToSrgbCode finds a code by the table of its thresholds; it must give the formula's code
+// for every float (checked exhaustively over [0, 1] once, docs/performance.md session 17). Here:
+// every 61st float of [0, 1], every float within 4096 of each code's boundary, and the ends.
+TEST(Image, SrgbCodesByTableAreTheFormulas) {
+    int checked = 0, wrong = 0;
+    const auto check = [&](float v) {
+        ++checked;
+        if (linearToSrgbCode(v) != srgbCodeByFormula(v) && ++wrong <= 5)
+            ADD_FAILURE() << "v = " << v << ": " << int(linearToSrgbCode(v)) << " against " << srgbCodeByFormula(v);
+    };
+    for (uint32_t bits = 0; bits <= 0x3f800000u; bits += 61) check(std::bit_cast<float>(bits));
+    for (int k = 1; k < 256; ++k) {
+        const uint32_t at = std::bit_cast<uint32_t>(srgbToLinear((float(k) - 0.5f) / 255.0f));
+        for (uint32_t bits = at - 4096; bits <= at + 4096; ++bits) check(std::bit_cast<float>(bits));
+    }
+    for (const float v : {0.f, -0.f, -1e-30f, -1.f, -INFINITY, 1.f, 1.0000001f, 7.f, INFINITY, NAN, -NAN}) check(v);
+    EXPECT_EQ(wrong, 0) << "of " << checked;
+    EXPECT_EQ(linearToSrgbCode(1.f), 255);
+    EXPECT_EQ(linearToSrgbCode(NAN), 0);
+}
+
+// The whole of [0, 1], every float (about 15 s on one core; not part of the suite): run with
+// build/test_image --gtest_also_run_disabled_tests --gtest_filter='*EveryFloat*'.
+TEST(Image, DISABLED_SrgbCodesOfEveryFloatInZeroOneAreTheFormulas) {
+    uint64_t wrong = 0;
+    for (uint32_t bits = 0; bits <= 0x3f800000u; ++bits) {
+        const float v = std::bit_cast<float>(bits);
+        wrong += linearToSrgbCode(v) != srgbCodeByFormula(v);
+    }
+    EXPECT_EQ(wrong, 0u);
+}
+
+// The writer (Paeth rows, run-length deflate) on a render-like image: black borders, flat runs,
+// gradients and noise in a 300×200 frame: every byte read back is the code written.
+TEST(Image, PngKeepsEveryCodeOfALargeImage) {
+    test::ScratchDir dir("image");
+    Image a(300, 200);
+    uint32_t state = 12345;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) {
+            state = state * 1664525u + 1013904223u;
+            const float noise = float(state >> 8) / float(1u << 24);
+            const bool border = x < 40 || y < 30;
+            a.at(x, y) = border ? glm::vec4(0.f) : glm::vec4(float(x) / a.width, noise, y % 17 < 8 ? 0.5f : 1e-3f, 1.f);
+        }
+    writeImage(dir.path("a.png"), a);
+    const Image b = readImage(dir.path("a.png"));
+    ASSERT_EQ(b.width, a.width);
+    ASSERT_EQ(b.height, a.height);
+    int wrong = 0;
+    for (size_t i = 0; i < a.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            wrong += b.pixels[i][c] != srgbToLinear(float(srgbCodeByFormula(a.pixels[i][c])) / 255.0f);
+    EXPECT_EQ(wrong, 0);
 }
 
 TEST(Image, ExrCarriesTheMetadataAsStringAttributes) {
