@@ -25,6 +25,8 @@
 
 #include <sys/stat.h>
 
+#include <tbb/global_control.h>
+
 #include "image/image.h"
 #include "support/cli.h"
 #include "support/error_of.h"
@@ -188,6 +190,31 @@ TEST(Image, PngKeepsEveryCodeOfALargeImage) {
         for (int c = 0; c < 3; ++c)
             wrong += b.pixels[i][c] != srgbToLinear(float(srgbCodeByFormula(a.pixels[i][c])) / 255.0f);
     EXPECT_EQ(wrong, 0);
+}
+
+// EXR line blocks are compressed on TBB's number of threads; the file must not depend on it.
+TEST(Image, ExrBytesDoNotDependOnTheThreadCount) {
+    test::ScratchDir dir("image");
+    Image a(257, 190);
+    uint32_t state = 7;
+    for (glm::vec4& p : a.pixels) {
+        state = state * 1664525u + 1013904223u;
+        p = glm::vec4(float(state >> 8) / float(1u << 24), 0.25f, float(state % 977) / 977.f, 1.f);
+    }
+    {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        writeImage(dir.path("one.exr"), a);
+    }
+    {
+        tbb::global_control four(tbb::global_control::max_allowed_parallelism, 4);
+        writeImage(dir.path("four.exr"), a);
+    }
+    const std::string one = test::slurp(dir.path("one.exr")), four = test::slurp(dir.path("four.exr"));
+    ASSERT_GT(one.size(), 100000u);
+    EXPECT_TRUE(one == four);
+    const Image b = readImage(dir.path("four.exr"));
+    ASSERT_EQ(b.pixels.size(), a.pixels.size());
+    EXPECT_TRUE(std::equal(a.pixels.begin(), a.pixels.end(), b.pixels.begin()));
 }
 
 TEST(Image, ExrCarriesTheMetadataAsStringAttributes) {
