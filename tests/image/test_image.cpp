@@ -133,6 +133,17 @@ TEST(Image, PngRoundTripsToTheEncodedSrgbValues) {
     for (const glm::vec4& p : b.pixels) EXPECT_EQ(p.w, 1.0f);
 }
 
+/// A @p w × @p h image of noise in R and B (a fixed LCG from @p seed), G = @p green: every code,
+/// no runs, for the writers' round trips.
+Image noiseImage(int w, int h, uint32_t seed, float green) {
+    Image img(w, h);
+    for (glm::vec4& p : img.pixels) {
+        seed = seed * 1664525u + 1013904223u;
+        p = glm::vec4(float(seed >> 8) / float(1u << 24), green, float(seed % 977) / 977.f, 1.f);
+    }
+    return img;
+}
+
 /// The formula the PNG codes stand for: lround(255·linearToSrgb(v)) as a byte (NaN: 0).
 int srgbCodeByFormula(float v) { return int(static_cast<uint8_t>(std::lround(255.0f * linearToSrgb(v)))); }
 
@@ -172,14 +183,12 @@ TEST(Image, DISABLED_SrgbCodesOfEveryFloatInZeroOneAreTheFormulas) {
 // gradients and noise in a 300×200 frame: every byte read back is the code written.
 TEST(Image, PngKeepsEveryCodeOfALargeImage) {
     test::ScratchDir dir("image");
-    Image a(300, 200);
-    uint32_t state = 12345;
+    Image a = noiseImage(300, 200, 12345, 0.f);
     for (int y = 0; y < a.height; ++y)
         for (int x = 0; x < a.width; ++x) {
-            state = state * 1664525u + 1013904223u;
-            const float noise = float(state >> 8) / float(1u << 24);
+            glm::vec4& p = a.at(x, y);
             const bool border = x < 40 || y < 30;
-            a.at(x, y) = border ? glm::vec4(0.f) : glm::vec4(float(x) / a.width, noise, y % 17 < 8 ? 0.5f : 1e-3f, 1.f);
+            p = border ? glm::vec4(0.f) : glm::vec4(float(x) / a.width, p.x, y % 17 < 8 ? 0.5f : 1e-3f, 1.f);
         }
     writeImage(dir.path("a.png"), a);
     const Image b = readImage(dir.path("a.png"));
@@ -195,12 +204,7 @@ TEST(Image, PngKeepsEveryCodeOfALargeImage) {
 // EXR line blocks are compressed on TBB's number of threads; the file must not depend on it.
 TEST(Image, ExrBytesDoNotDependOnTheThreadCount) {
     test::ScratchDir dir("image");
-    Image a(257, 190);
-    uint32_t state = 7;
-    for (glm::vec4& p : a.pixels) {
-        state = state * 1664525u + 1013904223u;
-        p = glm::vec4(float(state >> 8) / float(1u << 24), 0.25f, float(state % 977) / 977.f, 1.f);
-    }
+    const Image a = noiseImage(257, 190, 7, 0.25f);
     {
         tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
         writeImage(dir.path("one.exr"), a);
