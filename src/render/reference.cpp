@@ -99,8 +99,7 @@ bool lateralSlices(double oa, double da, double om, double dm, double lo, double
 
 }  // namespace
 
-ActiveRegions::ActiveRegions(const openvdb::FloatGrid& grid) {
-    const auto& tree = grid.tree();
+ActiveRegions::ActiveRegions(const openvdb::FloatTree& tree) {
     std::map<openvdb::Coord, openvdb::CoordBBox> regions;  // keyed by the 128³ region's origin
     const auto add = [&](const openvdb::CoordBBox& box) {
         if (box.dim().x() > kRegionSide) {
@@ -124,12 +123,12 @@ ActiveRegions::ActiveRegions(const openvdb::FloatGrid& grid) {
 RayIntegrator::RayIntegrator(const Volume& volume, const ClassificationTable& table, const ActiveRegions* regions,
                              const ShadingField* shading, const EmissionSource* emission, const KernelShape& kernel)
     : volume_(volume), table_(table), kernel_(kernel), kernelR2_(kernel.radius() * kernel.radius()),
-      accessor_(volume.grid->getConstAccessor()),
+      accessor_(*volume.tree),
       shading_(shading ? std::make_unique<ShadingField::Accessor>(shading->tree()) : nullptr),
       emission_(emission),
       emissionAccessor_(emission ? std::make_unique<EmissionSource::Accessor>(emission->accessor()) : nullptr),
       bins_(kRingSize),
-      ownRegions_(regions ? nullptr : std::make_unique<ActiveRegions>(*volume.grid)),
+      ownRegions_(regions ? nullptr : std::make_unique<ActiveRegions>(*volume.tree)),
       regions_(regions ? regions : ownRegions_.get()) {}
 
 std::vector<RayIntegrator::SliceRange>& RayIntegrator::sliceRanges(const glm::dvec3& o, const glm::dvec3& d, int m,
@@ -365,7 +364,7 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
     // Output rows per band, so a band's samples stay under ~128 MiB.
     const int bandRows = std::clamp(int((128.0 * (1 << 20)) / bytesPerRow) - 2 * border, 1, H);
     Image image(W, H);
-    const ActiveRegions regions(*volume.grid);
+    const ActiveRegions regions(*volume.tree);
     std::vector<glm::vec4> samples;
     const double cutoff2 = kPrefilterCutoffSigmas * kPrefilterCutoffSigmas * kPrefilterVariance;
     const int bands = (H + bandRows - 1) / bandRows;

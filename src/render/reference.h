@@ -42,7 +42,7 @@ inline constexpr double kReferenceEpsilon = 1e-4;
 /// and one per larger active tile. Built once per render (cost follows the leaf count).
 class ActiveRegions {
 public:
-    explicit ActiveRegions(const openvdb::FloatGrid& grid);
+    explicit ActiveRegions(const openvdb::FloatTree& tree);
     const std::vector<openvdb::CoordBBox>& boxes() const { return boxes_; }
 
 private:

@@ -61,7 +61,7 @@ VoxelShader::VoxelShader(const Volume& volume, const ClassificationTable& table,
                          const glm::dvec3& eye, const ShadingSettings& settings)
     : volume_(volume), table_(table), settings_(settings),
       gradientToWorld_(glm::transpose(glm::mat3(glm::dmat3(volume.worldToIndex)))), eye_(eye),
-      background_(volume.grid->background()), lo_(lo), hi_(hi > lo ? hi : lo + 1.f) {
+      background_(volume.tree->background()), lo_(lo), hi_(hi > lo ? hi : lo + 1.f) {
     if (settings.hasLight) toLight_ = glm::vec3(glm::normalize(settings.light));
 }
 
@@ -83,18 +83,18 @@ openvdb::Vec3f VoxelShader::operator()(Accessor& acc, const FloatLeaf* leaf, ope
 
 ShadingField::ShadingField(const VoxelShader& shader) {
     const auto start = std::chrono::steady_clock::now();
-    const openvdb::FloatGrid& grid = *shader.volume().grid;
+    const openvdb::FloatTree& values = *shader.volume().tree;
     const openvdb::Vec3f unshaded(1.f, 0.f, 1.f);
-    tree_ = std::make_shared<Tree>(grid.tree(), unshaded, unshaded, openvdb::TopologyCopy());
+    tree_ = std::make_shared<Tree>(values, unshaded, unshaded, openvdb::TopologyCopy());
     tree_->voxelizeActiveTiles();
     std::vector<Leaf*> leaves;
     leaves.reserve(tree_->leafCount());
     tree_->getNodes(leaves);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
-        VoxelShader::Accessor acc(grid.tree());  // one per task, never shared
+        VoxelShader::Accessor acc(values);  // one per task, never shared
         for (size_t i = r.begin(); i < r.end(); ++i) {
             Leaf& leaf = *leaves[i];
-            const FloatLeaf* source = grid.tree().probeConstLeaf(leaf.origin());  // null: a voxelized tile
+            const FloatLeaf* source = values.probeConstLeaf(leaf.origin());  // null: a voxelized tile
             for (auto it = leaf.beginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
                 const float value = source ? source->getValue(it.pos()) : acc.getValue(ijk);

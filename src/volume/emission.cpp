@@ -44,10 +44,10 @@ void normalisedRange(float valueMin, float valueMax, float& lo, float& hi) {
     hi = valueMax > valueMin ? valueMax : valueMin + 1.f;
 }
 
-std::string describeVoxelSize(const openvdb::math::Transform& t) {
+std::string describeVoxelSize(const Volume& volume) {
     std::ostringstream s;
     s.precision(6);
-    const openvdb::Vec3d v = t.voxelSize();
+    const openvdb::Vec3d v = volume.map->voxelSize();
     s << v.x() << " x " << v.y() << " x " << v.z();
     return s.str();
 }
@@ -138,31 +138,30 @@ std::unique_ptr<EmissionSource> makeEmissionSource(const Volume& volume, const E
 
 void attachEmission(Volume& density, Volume emission) {
     const std::string where = emission.file.empty() ? std::string("<memory>") : emission.file;
-    if (emission.grid->transform() != density.grid->transform())
+    if (!sameTransform(emission, density))
         throw Error(where + ": emission grid '" + emission.name + "' has another transform than density grid '" +
-                    density.name + "' (voxel size " + describeVoxelSize(emission.grid->transform()) + " against " +
-                    describeVoxelSize(density.grid->transform()) +
+                    density.name + "' (voxel size " + describeVoxelSize(emission) + " against " + describeVoxelSize(density) +
                     "); both must share voxel size, orientation and offset");
     auto out = std::make_shared<EmissionGrid>();
-    out->grid = emission.grid;
+    out->tree = emission.tree;
     out->name = emission.name;
     out->valueMin = emission.valueMin, out->valueMax = emission.valueMax;
     out->activeVoxels = emission.activeVoxels;
     // The emission-only voxels: active in the emission grid, not in the density grid.
-    openvdb::BoolTree only(emission.grid->tree(), false, openvdb::TopologyCopy());
-    only.topologyDifference(density.grid->tree());
+    openvdb::BoolTree only(*emission.tree, false, openvdb::TopologyCopy());
+    only.topologyDifference(*density.tree);
     out->outsideDensity = only.activeVoxelCount();
     if (out->outsideDensity > 0) {
-        openvdb::FloatTree& tree = density.grid->tree();
+        openvdb::FloatTree& tree = *density.tree;
         const float background = tree.background();
-        tree.topologyUnion(emission.grid->tree());
+        tree.topologyUnion(*emission.tree);
         // Activated voxels keep whatever inactive value the density leaf held: set the background.
         for (auto it = only.cbeginValueOn(); it; ++it) {
             if (it.isVoxelValue()) tree.setValueOn(it.getCoord(), background);
             else tree.fill(it.getBoundingBox(), background, true);
         }
         density.activeVoxels = tree.activeVoxelCount();
-        density.indexBox = density.grid->evalActiveVoxelBoundingBox();
+        density.indexBox = activeVoxelBounds(tree);
     }
     density.emission = std::move(out);
 }

@@ -51,7 +51,7 @@ struct EmissionSettings {
 
 /// @brief The emission grid attached to a density Volume (attachEmission).
 struct EmissionGrid {
-    openvdb::FloatGrid::Ptr grid;     ///< values as float, non-finite values zeroed
+    std::shared_ptr<const openvdb::FloatTree> tree;  ///< values as float, non-finite values zeroed
     std::string name;
     float valueMin = 0.f, valueMax = 1.f;  ///< range of its finite active values
     uint64_t activeVoxels = 0;
@@ -82,7 +82,7 @@ class EmissionSource {
 public:
     using Accessor = openvdb::tree::ValueAccessor<const openvdb::FloatTree, false>;
     EmissionSource(const EmissionGrid& grid, ClassificationTable table) : grid_(grid), table_(std::move(table)) {}
-    Accessor accessor() const { return Accessor(grid_.grid->tree()); }
+    Accessor accessor() const { return Accessor(*grid_.tree); }
     /// ε at voxel @p ijk (RGB, per voxel length); 0 where the emission grid is inactive.
     glm::vec3 at(Accessor& acc, const openvdb::Coord& ijk) const {
         float v;

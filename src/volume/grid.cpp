@@ -79,22 +79,22 @@ openvdb::GridBase::Ptr readGridToRender(const std::string& path, const std::stri
 /// h = |det A|^(1/3), the edge of the cube of the voxel's volume: the energy rule's M = h³ is
 /// the kernel's world volume, and a transfer function's "per voxel" extinction is per h.
 /// Refuses frustum (non-linear) maps and singular or non-finite matrices.
-glm::dmat4 linearAffineMap(const openvdb::math::Transform& transform, const std::string& label, double& voxelSize,
+glm::dmat4 linearAffineMap(const openvdb::math::MapBase& map, const std::string& label, double& voxelSize,
                            bool& isotropic) {
-    if (!transform.isLinear()) throw Error(label + ": transform is not linear (frustum maps are not supported)");
+    if (!map.isLinear()) throw Error(label + ": transform is not linear (frustum maps are not supported)");
     openvdb::Mat4d m;
     try {  // OpenVDB inverts the matrix as it builds the affine map: a singular one throws
-        m = transform.baseMap()->getAffineMap()->getMat4();
+        m = map.getAffineMap()->getMat4();
     } catch (const std::exception& e) {
         throw Error(label + ": transform is singular or invalid (" + std::string(e.what()) + ")");
     }
-    glm::dmat4 map(1.0);
+    glm::dmat4 out(1.0);
     for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) map[c][r] = m(c, r);  // OpenVDB is row-vector: world = [i j k 1]·m
-    const glm::dvec3 a0(map[0]), a1(map[1]), a2(map[2]);
+        for (int r = 0; r < 4; ++r) out[c][r] = m(c, r);  // OpenVDB is row-vector: world = [i j k 1]·m
+    const glm::dvec3 a0(out[0]), a1(out[1]), a2(out[2]);
     const double h0 = glm::length(a0), h1 = glm::length(a1), h2 = glm::length(a2);
-    const double det = glm::determinant(glm::dmat3(map));
-    if (!std::isfinite(h0 + h1 + h2 + det) || !std::isfinite(map[3].x + map[3].y + map[3].z))
+    const double det = glm::determinant(glm::dmat3(out));
+    if (!std::isfinite(h0 + h1 + h2 + det) || !std::isfinite(out[3].x + out[3].y + out[3].z))
         throw Error(label + ": transform has a non-finite entry");
     if (!(h0 > 0.0 && h1 > 0.0 && h2 > 0.0)) throw Error(label + ": transform has a zero voxel size");
     // |det| against the product of the column lengths: 1 for orthogonal axes, 0 for a flat map.
@@ -105,14 +105,19 @@ glm::dmat4 linearAffineMap(const openvdb::math::Transform& transform, const std:
     isotropic = std::abs(h1 - h0) <= tol && std::abs(h2 - h0) <= tol && std::abs(glm::dot(a0, a1)) <= tol * h0 &&
                 std::abs(glm::dot(a0, a2)) <= tol * h0 && std::abs(glm::dot(a1, a2)) <= tol * h0;
     if (isotropic) voxelSize = h0;  // a rotation of cubes: exactly the column length, as before
-    return map;
+    return out;
+}
+
+glm::dmat4 linearAffineMap(const openvdb::math::Transform& transform, const std::string& label, double& voxelSize,
+                           bool& isotropic) {
+    return linearAffineMap(*transform.baseMap(), label, voxelSize, isotropic);
 }
 
 /// Replaces non-finite active values by 0 and measures the finite value range.
 void sanitizeValues(Volume& v) {
     float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
     uint64_t bad = 0;
-    for (auto it = v.grid->beginValueOn(); it; ++it) {
+    for (auto it = v.tree->beginValueOn(); it; ++it) {
         const float x = *it;
         if (!std::isfinite(x)) {
             it.setValue(0.0f);
@@ -140,6 +145,15 @@ size_t defaultGridIndex(const std::vector<std::string>& names, const std::vector
     return first;
 }
 
+
+bool sameTransform(const Volume& a, const Volume& b) {
+    // openvdb::math::Transform::operator== (math/Transform.cc), on the maps themselves.
+    const openvdb::math::MapBase &p = *a.map, &q = *b.map;
+    if (!p.voxelSize().eq(q.voxelSize())) return false;
+    if (p.type() == q.type()) return p.isEqual(q);
+    if (p.isLinear() && q.isLinear()) return *p.getAffineMap() == *q.getAffineMap();
+    return p.isEqual(q);
+}
 
 std::string transformProblem(const openvdb::math::Transform& transform) {
     try {
@@ -188,25 +202,33 @@ std::string gridLabel(const std::string& label, const std::string& name) {
     return label + (name.empty() ? "" : " grid '" + name + "'");
 }
 
-/// A Volume around @p grid of @p activeVoxels active voxels, values not yet sanitized.
-Volume wrapGrid(openvdb::FloatGrid::Ptr grid, const std::string& label, uint64_t activeVoxels) {
+/// A Volume around @p tree, named @p name, with index-to-world map @p map, of @p activeVoxels
+/// active voxels, values not yet sanitized.
+Volume wrapTree(std::shared_ptr<openvdb::FloatTree> tree, std::string name, openvdb::math::MapBase::ConstPtr map,
+                const std::string& label, uint64_t activeVoxels) {
     Volume v;
-    v.grid = std::move(grid);
-    v.name = v.grid->getName();
+    v.tree = std::move(tree);
+    v.name = std::move(name);
+    v.map = std::move(map);
     const std::string where = gridLabel(label, v.name);
-    v.indexToWorld = linearAffineMap(v.grid->transform(), where, v.voxelSize, v.isotropic);
+    v.indexToWorld = linearAffineMap(*v.map, where, v.voxelSize, v.isotropic);
     v.worldToIndex = glm::inverse(v.indexToWorld);
     v.activeVoxels = activeVoxels;
     if (v.activeVoxels == 0) throw Error(where + ": grid has no active voxels");
-    v.indexBox = v.grid->evalActiveVoxelBoundingBox();
+    v.indexBox = activeVoxelBounds(*v.tree);
     return v;
+}
+
+/// wrapTree of an in-memory (or OpenVDB-read) grid: its tree, name and map.
+Volume wrapGrid(const openvdb::FloatGrid::Ptr& grid, const std::string& label, uint64_t activeVoxels) {
+    return wrapTree(grid->treePtr(), grid->getName(), grid->transform().baseMap(), label, activeVoxels);
 }
 
 }  // namespace
 
 Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label) {
     const uint64_t active = grid->activeVoxelCount();
-    Volume v = wrapGrid(std::move(grid), label, active);
+    Volume v = wrapGrid(grid, label, active);
     sanitizeValues(v);
     return v;
 }
@@ -243,6 +265,7 @@ namespace {
 // its values as it goes. OpenVDB's log lines are captured in the child and written here only
 // when the read succeeded, as before; this process's stderr is never redirected.
 Volume loadInChild(const std::string& path, const std::string& gridName) {
+    initOpenVdb();  // OpenVDB's reader (in the child) and the hand-over's transform (here)
     TransferMemory transfer(path);
     ChildRead child(path, [&](const std::function<void(uint64_t)>& hint) {
         OpenVdbLogCapture log;
@@ -272,7 +295,7 @@ Volume loadInChild(const std::string& path, const std::string& gridName) {
     }
     DecodedGrid decoded = transfer.decode();
     if (!decoded.log.empty()) std::cerr << decoded.log;
-    Volume v = wrapGrid(std::move(decoded.grid), path, decoded.activeVoxels);
+    Volume v = wrapGrid(decoded.grid, path, decoded.activeVoxels);
     v.nonFiniteCount = decoded.nonFiniteCount;
     v.valueMin = decoded.valueMin;
     v.valueMax = decoded.valueMax;
@@ -285,11 +308,10 @@ Volume loadInChild(const std::string& path, const std::string& gridName) {
 // (volume/vdb_reader.h), which checks every byte before it allocates or indexes from it;
 // whatever it does not cover goes to OpenVDB's reader in a forked child (loadInChild).
 Volume loadVolume(const std::string& path, const std::string& gridName) {
-    initOpenVdb();
     checkVdbFile(path);
     std::optional<ReadGrid> read = readVdbGrid(path, gridName);
     if (!read) return loadInChild(path, gridName);
-    Volume v = wrapGrid(std::move(read->grid), path, read->activeVoxels);
+    Volume v = wrapTree(std::move(read->tree), std::move(read->name), std::move(read->map), path, read->activeVoxels);
     v.nonFiniteCount = read->nonFiniteCount;
     v.valueMin = read->valueMin;
     v.valueMax = read->valueMax;

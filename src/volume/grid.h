@@ -17,7 +17,12 @@ struct EmissionGrid;  // volume/emission.h
 
 /// @brief One scalar grid ready to render.
 struct Volume {
-    openvdb::FloatGrid::Ptr grid;   ///< values as float; non-finite values were set to 0 (see nonFiniteCount)
+    /// The values as float (a .vdb grid's tree, or an in-memory grid's); non-finite values were
+    /// set to 0 (see nonFiniteCount). A Volume holds no openvdb::Grid: reading one from a .vdb
+    /// file never calls into libopenvdb (volume/vdb_types.h).
+    std::shared_ptr<openvdb::FloatTree> tree;
+    /// The grid's index-to-world map, OpenVDB's own object (indexToWorld is its matrix).
+    openvdb::math::MapBase::ConstPtr map;
     std::string file;               ///< the file it came from ("" if generated in memory)
     std::string name;               ///< the grid's name
     /// h, world units per voxel: |det A|^(1/3) for the linear part A of indexToWorld (the edge
@@ -42,7 +47,16 @@ struct Volume {
     double largestAxis() const;
 };
 
-/// @brief Calls openvdb::initialize() once (thread-safe, idempotent).
+/// @brief The bounding box of the active voxels of @p tree (inclusive), as Grid::evalActiveVoxelBoundingBox.
+inline openvdb::CoordBBox activeVoxelBounds(const openvdb::FloatTree& tree) {
+    openvdb::CoordBBox box;
+    tree.evalActiveVoxelBoundingBox(box);
+    return box;
+}
+
+/// @brief Calls openvdb::initialize() once (thread-safe, idempotent). Whatever reaches OpenVDB's
+/// registries calls it first (its I/O, MetaMap and Transform reading); loading a .vdb file that
+/// vdbsplat's own reader covers does not.
 void initOpenVdb();
 
 /// @brief Loads grid @p gridName (or, if empty, defaultGridIndex's grid) from @p path: with
@@ -55,6 +69,11 @@ Volume loadVolume(const std::string& path, const std::string& gridName = "");
 
 /// @brief Wraps an in-memory float grid (tests, generators) as a Volume, validating it as loadVolume does.
 Volume makeVolume(openvdb::FloatGrid::Ptr grid, const std::string& label = "<memory>");
+
+/// @brief True when the grids of @p a and @p b share their transform as openvdb::math::Transform's
+/// operator== decides it (voxel sizes within 1e-8, then the maps: linear maps as affine
+/// matrices within 1e-8 per entry), computed with OpenVDB's header-only map classes.
+bool sameTransform(const Volume& a, const Volume& b);
 
 /// @brief Empty when vdbsplat can render a grid with transform @p transform, else the reason
 /// (the check loadVolume applies; `vdbsplat info` reports it).

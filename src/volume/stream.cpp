@@ -90,7 +90,7 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
 }
 
 void VoxelStream::collectBlocks() {
-    const auto& tree = volume_.grid->tree();
+    const auto& tree = *volume_.tree;
     // The leaves from the internal nodes' tables (the leaf iterator's order), their voxel counts in
     // parallel: each count reads a leaf's mask for the first time since the load, and the iterator
     // walked them one dependent miss after another (0.5 ms of the far Engine's 10).
@@ -248,7 +248,7 @@ public:
     VoxelClassifier(const Volume& volume, const ClassificationTable& table, const VoxelShader* shader,
                     const EmissionSource* emission)
         : table_(table), shader_(shader), emission_(emission) {
-        if (shader_) shaderAcc_.emplace(volume.grid->tree());
+        if (shader_) shaderAcc_.emplace(*volume.tree);
         if (emission_) emissionAcc_.emplace(emission_->accessor());
     }
     Classified operator()(const openvdb::FloatTree::LeafNodeType* leaf, openvdb::Index n, const openvdb::Coord& ijk,
@@ -468,7 +468,7 @@ void VoxelStream::prepareMomentCache(size_t blocks) {
     LodMomentCache& cache = *moments_;
     uint64_t key = fnv1a64(volume_.file.data(), volume_.file.size());
     key = fnv1a64(volume_.name.data(), volume_.name.size(), key);
-    const uintptr_t tree = reinterpret_cast<uintptr_t>(&volume_.grid->tree());
+    const uintptr_t tree = reinterpret_cast<uintptr_t>(&*volume_.tree);
     const uint64_t counts[2] = {volume_.activeVoxels, blocks};
     key = fnv1a64(&tree, sizeof tree, key);
     key = fnv1a64(counts, sizeof counts, key);

@@ -30,6 +30,7 @@
 
 #include "util/error.h"
 #include "volume/grid.h"
+#include "volume/vdb_types.h"
 
 namespace vdbsplat {
 
@@ -99,23 +100,12 @@ private:
     std::string path_;
 };
 
-/// Bytes OpenVDB's reader consumes for a metadata value of @p type: a registered fixed-size
-/// type (TypedMetadata<T>, Metadata.h) reads sizeof(T) whatever size the file declares, so
-/// the check must walk the same bytes or it goes out of step with the reader (a fuzzed
-/// `int64` item declaring 9 bytes made OpenVDB take a string length from the wrong place:
-/// 5 GB allocated for a 5.6 KB file). std::nullopt: the declared size is what is read
-/// ("string" and unregistered types, read as UnknownMetadata).
-std::optional<uint64_t> fixedMetadataBytes(const std::string& type) {
-    if (type == "string" || type.empty() || !openvdb::Metadata::isRegisteredType(type)) return std::nullopt;
-    try {
-        return openvdb::Metadata::createMetadata(type)->size();
-    } catch (const std::exception&) {
-        return std::nullopt;
-    }
-}
-
 /// A metadata block (the file's or a grid's): every item within the reader's limit, each
-/// fixed-size value declaring exactly the size OpenVDB reads.
+/// fixed-size value declaring exactly the size OpenVDB reads. OpenVDB's reader consumes
+/// sizeof(T) of a registered fixed-size type (TypedMetadata<T>, Metadata.h) whatever size the
+/// file declares, so the check must walk the same bytes or it goes out of step with the reader
+/// (a fuzzed `int64` item declaring 9 bytes made OpenVDB take a string length from the wrong
+/// place: 5 GB allocated for a 5.6 KB file); fixedMetadataBytes (volume/vdb_types.h) knows them.
 void skipMetadata(Reader& r, uint64_t end) {
     const int32_t count = r.value<int32_t>("metadata count");
     if (count < 0 || uint64_t(count) > (end - std::min(end, r.pos())) / 12) r.corrupt("metadata count");
@@ -220,7 +210,6 @@ uint64_t vdbMapBytes(const std::string& type) {
 }
 
 void checkVdbStructure(const std::string& path) {
-    initOpenVdb();  // the metadata type registry (fixedMetadataBytes)
     std::error_code ec;
     const uint64_t size = std::filesystem::file_size(path, ec);
     if (ec) throw Error(path + ": cannot read (" + ec.message() + ")");
@@ -251,6 +240,7 @@ void checkVdbFile(const std::string& path) {
 
 void openVdbFile(openvdb::io::File& file, const std::string& path) {
     checkVdbFile(path);
+    initOpenVdb();  // OpenVDB's metadata, map and grid registries
     try {
         file.open(/*delayLoad=*/false);
     } catch (const std::exception& e) {

@@ -38,6 +38,8 @@
 #include <memory>
 #include <mutex>
 #include <streambuf>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include <fcntl.h>
@@ -48,6 +50,7 @@
 #include "util/error.h"
 #include "volume/grid.h"
 #include "volume/vdb_check.h"
+#include "volume/vdb_types.h"
 
 namespace vdbsplat {
 
@@ -114,6 +117,11 @@ public:
         if (to < pos_ || to > end_) corrupt(what);
         pos_ = to;
     }
+    /// Back to @p to, a position this cursor has already passed (to read the same bytes again).
+    void rewind(uint64_t to) {
+        if (to > pos_) corrupt("a position ahead");
+        pos_ = to;
+    }
     uint64_t pos() const { return pos_; }
     const char* here() const { return f_->data + pos_; }
     uint64_t left() const { return end_ - pos_; }
@@ -127,19 +135,10 @@ private:
     uint64_t pos_, end_;
 };
 
-/// A read-only std::istream over bytes in memory (for OpenVDB's metadata and map readers).
-class MemoryStream : private std::streambuf, public std::istream {
-public:
-    MemoryStream(const char* data, uint64_t size) : std::istream(static_cast<std::streambuf*>(this)) {
-        char* p = const_cast<char*>(data);  // never written: a get area only
-        setg(p, p, p + size);
-    }
-};
-
 // ---- file header, metadata, descriptors ----------------------------------------------------
 
 /// Walks a metadata block as OpenVDB's MetaMap::readMeta reads it (a registered fixed-size
-/// type reads its own size: it must declare that size, as checkVdbStructure requires).
+/// type reads its own size, fixedMetadataBytes: it must declare that size, as checkVdbStructure requires).
 void skipMetadata(Cursor& c) {
     const int32_t count = c.get<int32_t>("metadata count");
     if (count < 0 || uint64_t(count) > c.left() / 12) c.corrupt("metadata count");
@@ -147,15 +146,8 @@ void skipMetadata(Cursor& c) {
         c.take(c.get<uint32_t>("metadata name"), "metadata name");
         const std::string type = c.string("metadata type");
         const uint32_t declared = c.get<uint32_t>("metadata value size");
-        if (type != "string" && openvdb::Metadata::isRegisteredType(type)) {
-            uint32_t fixed = 0;
-            try {
-                fixed = openvdb::Metadata::createMetadata(type)->size();
-            } catch (const std::exception&) {
-                throw Unsupported{"a metadata type without a size"};
-            }
-            if (fixed != declared) c.corrupt("metadata value size");
-        }
+        const std::optional<uint64_t> fixed = fixedMetadataBytes(type);
+        if (fixed && *fixed != declared) c.corrupt("metadata value size");
         c.take(declared, "metadata value");
     }
 }
@@ -197,7 +189,7 @@ std::vector<Descriptor> readDescriptors(const Image& f) {
             d.type.resize(d.type.size() - kHalf.size());
             d.half = true;
         }
-        if (!openvdb::GridBase::isRegistered(d.type)) throw Unsupported{"an unregistered grid type"};
+        if (!isRegisteredGridType(d.type)) throw Unsupported{"an unregistered grid type"};
         c.seek(uint64_t(d.endPos), "grid end offset");  // OpenVDB reads the next descriptor there
     }
     return out;
@@ -631,43 +623,58 @@ private:
     FirstError errors_;
 };
 
-/// The transform OpenVDB's Transform::read makes (a linear map of a type vdbMapBytes knows),
-/// read by that function from exactly the bytes of its type name and map: no simplification,
-/// the map type kept, a singular map left for loadVolume's check to name.
-openvdb::math::Transform::Ptr readTransform(Cursor& c) {
+/// The linear map OpenVDB's Transform::read makes of the grid's transform (a type vdbMapBytes
+/// knows), read by OpenVDB's own map class from exactly its bytes (readLinearMap: header-only
+/// code, no registry): no simplification, the map type kept, a singular map left for
+/// loadVolume's check to name. @p bytes gets the transform's bytes, type name included.
+openvdb::math::MapBase::Ptr readTransform(Cursor& c, std::string& bytes) {
     const uint64_t begin = c.pos();
     const char* start = c.here();
     const std::string type = c.string("grid transform type");
-    const uint64_t bytes = vdbMapBytes(type);
-    if (bytes == 0 || !openvdb::math::MapRegistry::isRegistered(type)) throw Unsupported{"a map type not read here"};
-    c.take(bytes, "grid transform");
-    MemoryStream in(start, c.pos() - begin);
-    openvdb::io::setCurrentVersion(in);  // the map layout of file versions 219 and later
-    openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform();
+    const uint64_t mapBytes = vdbMapBytes(type);
+    if (mapBytes == 0) throw Unsupported{"a map type not read here"};
+    const char* map = c.here();
+    c.take(mapBytes, "grid transform");
+    bytes.assign(start, c.pos() - begin);
     try {
-        transform->read(in);
+        return readLinearMap(type, std::string_view(map, mapBytes));
     } catch (const std::exception& e) {
         c.corrupt("grid transform (" + std::string(e.what()) + ")");
     }
-    if (!in) c.corrupt("grid transform");
-    return transform;
 }
 
-/// A metadata block as MetaMap::readMeta reads it, from bytes skipMetadata has walked
-/// ("file_delayed_load" dropped, as io::File drops it).
-openvdb::MetaMap readMetadata(Cursor& c) {
+/// The grid's "name" as GridBase::getName() gives it after MetaMap::readMeta, from a metadata
+/// block skipMetadata has walked (@p bytes gets the block): the last "name" item's string, ""
+/// without one. Blocks MetaMap::readMeta would refuse or read otherwise (an empty item name, an
+/// item name given two types, a non-string "name") are left to OpenVDB.
+std::string readGridName(Cursor& c, std::string& bytes) {
     const char* start = c.here();
     const uint64_t begin = c.pos();
-    skipMetadata(c);
-    MemoryStream in(start, c.pos() - begin);
-    openvdb::MetaMap meta;
-    try {
-        meta.readMeta(in);
-    } catch (const std::exception& e) {
-        c.corrupt("grid metadata (" + std::string(e.what()) + ")");
+    skipMetadata(c);  // every size checked; then the same bytes again, for the names
+    const uint64_t end = c.pos();
+    bytes.assign(start, end - begin);
+    Cursor& m = c;
+    m.rewind(begin);
+    std::vector<std::pair<std::string, std::string>> types;  // item name, its type
+    std::string name;
+    const int32_t count = m.get<int32_t>("metadata count");
+    for (int32_t i = 0; i < count; ++i) {
+        const std::string item = m.string("metadata name");
+        const std::string type = m.string("metadata type");
+        const uint32_t size = m.get<uint32_t>("metadata value size");
+        const char* value = m.here();
+        m.take(size, "metadata value");
+        if (item.empty()) throw Unsupported{"a metadata item without a name"};
+        const auto seen = std::find_if(types.begin(), types.end(), [&](const auto& t) { return t.first == item; });
+        if (seen == types.end()) types.emplace_back(item, type);
+        else if (seen->second != type) throw Unsupported{"a metadata item given two types"};
+        if (item == "name") {
+            if (type != "string") throw Unsupported{"a grid name that is not a string"};
+            name.assign(value, size);
+        }
     }
-    meta.removeMeta(openvdb::GridBase::META_FILE_DELAYED_LOAD);
-    return meta;
+    if (m.pos() != end) m.corrupt("grid metadata");  // cannot happen: skipMetadata walked these bytes
+    return name;
 }
 
 /// The grid of descriptor @p d: its header and topology in [gridPos, blockPos), its leaf
@@ -678,8 +685,9 @@ ReadGrid readGrid(const Image& f, const Descriptor& d) {
     Codec<V> codec;
     codec.compression = head.get<uint32_t>("grid compression flags");
     codec.half = d.half;
-    const openvdb::MetaMap meta = readMetadata(head);
-    const openvdb::math::Transform::Ptr transform = readTransform(head);
+    ReadGrid out;
+    out.name = readGridName(head, out.metadata);
+    out.map = readTransform(head, out.transform);
     if (head.get<int32_t>("tree buffer count") != 1) throw Unsupported{"a tree buffer count other than 1"};
     codec.background = head.get<V>("root background value");
     TreeReader<V> reader(f, codec);
@@ -688,11 +696,8 @@ ReadGrid readGrid(const Image& f, const Descriptor& d) {
     Cursor buffers(f, uint64_t(d.blockPos), uint64_t(d.endPos));
     const Stats stats = reader.readLeaves(buffers);
 
-    ReadGrid out;
-    out.grid = openvdb::FloatGrid::create(tree);
-    static_cast<openvdb::MetaMap&>(*out.grid) = meta;
-    out.grid->setTransform(transform);
-    out.activeVoxels = out.grid->activeVoxelCount();
+    out.activeVoxels = tree->activeVoxelCount();
+    out.tree = std::move(tree);
     out.nonFiniteCount = stats.nonFinite;
     out.valueMin = stats.lo <= stats.hi ? stats.lo : 0.0f;
     out.valueMax = stats.lo <= stats.hi ? stats.hi : 0.0f;
@@ -750,7 +755,6 @@ private:
 
 namespace {
 std::optional<ReadGrid> readImage(const Image& f, const std::string& gridName, std::string* unsupported) {
-    initOpenVdb();  // the metadata, map and grid type registries
     try {
         const std::vector<Descriptor> all = readDescriptors(f);
         const Descriptor& d = chooseGrid(all, gridName);
@@ -775,6 +779,22 @@ std::optional<ReadGrid> readVdbGrid(const std::string& path, const std::string& 
     f.willNeed = [&](uint64_t begin, uint64_t end) { file.willNeed(begin, end); };
     f.release = [&](uint64_t, uint64_t end) { file.release(end); };
     return readImage(f, gridName, unsupported);
+}
+
+openvdb::FloatGrid::Ptr toOpenVdbGrid(const ReadGrid& read) {
+    initOpenVdb();  // the metadata and map registries
+    openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(read.tree);
+    MemoryStream meta(read.metadata);
+    openvdb::MetaMap map;
+    map.readMeta(meta);
+    map.removeMeta("file_delayed_load");  // GridBase::META_FILE_DELAYED_LOAD (data in libopenvdb: not named here)
+    static_cast<openvdb::MetaMap&>(*grid) = map;
+    MemoryStream in(read.transform);
+    openvdb::io::setCurrentVersion(in);  // the map layout of file versions 219 and later
+    openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform();
+    transform->read(in);
+    grid->setTransform(transform);
+    return grid;
 }
 
 }  // namespace vdbsplat

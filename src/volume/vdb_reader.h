@@ -2,7 +2,8 @@
 // Owns: readVdbGrid, which reads one float or double grid of an OpenVDB file (file versions
 // 222-224: OpenVDB 3 to 10; blosc, zlib or raw leaf data; half-float storage; all seven
 // per-node mask-compression modes; tiles at every level; the linear maps OpenVDB writes)
-// straight into an openvdb::FloatGrid: nodes allocated once, leaf values decompressed into
+// straight into an openvdb::FloatTree (its name and map parsed here too: no call into
+// libopenvdb, volume/vdb_types.h): nodes allocated once, leaf values decompressed into
 // the leaf buffers (in parallel), non-finite active values replaced by 0 and the value range
 // measured as they land. Every count, size, offset and mask is checked against the bytes of
 // the grid before anything is allocated or indexed from it, so a damaged file ends in one
@@ -15,18 +16,31 @@
 #include "volume/openvdb_extern.h"  // <openvdb/openvdb.h>, grid classes extern
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 
 namespace vdbsplat {
 
-/// @brief A grid read by readVdbGrid, with the value statistics loadVolume needs.
+/// @brief A grid read by readVdbGrid, with the value statistics loadVolume needs: the tree, its
+/// name and its map, made without a call into libopenvdb (volume/vdb_types.h), and the grid's
+/// metadata and transform as the bytes OpenVDB would read them (toOpenVdbGrid).
 struct ReadGrid {
-    openvdb::FloatGrid::Ptr grid;  ///< the grid as OpenVDB's io::File::readGrid reads it (double: cast to float)
+    std::shared_ptr<openvdb::FloatTree> tree;  ///< the values as OpenVDB reads them (double: cast to float)
+    std::string name;                          ///< the grid's "name" metadata, as GridBase::getName()
+    openvdb::math::MapBase::Ptr map;           ///< the linear map Transform::read makes of the file's bytes
+    std::string metadata;                      ///< the grid's metadata block (MetaMap::readMeta's bytes)
+    std::string transform;                     ///< the transform's bytes (type name and map: Transform::read's)
     uint64_t activeVoxels = 0;     ///< active voxels, tiles counted as their voxels
     uint64_t nonFiniteCount = 0;   ///< active voxels whose NaN/inf value was replaced by 0
     float valueMin = 0.f, valueMax = 0.f;  ///< finite active value range (0, 0 if there is none)
 };
+
+/// @brief The openvdb::FloatGrid io::File::readGrid makes of the same bytes: the tree shared, the
+/// metadata read by MetaMap::readMeta ("file_delayed_load" dropped, as io::File drops it) and
+/// the transform by Transform::read (both in libopenvdb: for tests and tools, not the render path).
+/// @throw std::exception as those readers throw.
+openvdb::FloatGrid::Ptr toOpenVdbGrid(const ReadGrid& read);
 
 /// @brief Reads grid @p gridName (or, if empty, defaultGridIndex's grid) of the .vdb file
 /// image @p data of @p size bytes; @p label names it in errors.

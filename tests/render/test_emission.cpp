@@ -28,7 +28,7 @@ Volume oneVoxel(float value, double h = 1.0) { return test::boxVolume(openvdb::C
 Volume emissionBox(const Volume& like, openvdb::Coord lo, openvdb::Coord hi) {
     auto grid = openvdb::FloatGrid::create(0.f);
     grid->setName("temperature");
-    grid->setTransform(like.grid->transform().copy());
+    grid->setTransform(std::make_shared<openvdb::math::Transform>(like.map->copy()));
     grid->denseFill(openvdb::CoordBBox(lo, hi), 1.f, true);
     grid->tree().voxelizeActiveTiles();
     return makeVolume(grid, "test-emission");

@@ -85,7 +85,7 @@ TEST(Reference, EmptySpaceSkippingLeavesEveryRayBitIdentical) {
     const Volume volume = makeVolume(grid, "clusters");
     auto cover = openvdb::FloatGrid::create(0.f);
     cover->tree().fill(volume.indexBox, 1.f, true);
-    const ActiveRegions everything(*cover);
+    const ActiveRegions everything(cover->tree());
     const ClassificationTable table = test::rampTable(0.6f);
     RayIntegrator skipping(volume, table), full(volume, table, &everything);
     const glm::dvec3 eye(-400.0, -300.0, 250.0);

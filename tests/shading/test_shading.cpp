@@ -307,7 +307,7 @@ TEST(ShadingRender, ActiveTilesShadeLikeLeaves) {
         return makeVolume(grid, voxelize ? "leaves" : "tiles");
     };
     const Volume tiles = make(false), leaves = make(true);
-    ASSERT_GT(tiles.grid->tree().activeTileCount(), 0u);
+    ASSERT_GT(tiles.tree->activeTileCount(), 0u);
     const TransferFunction tf = TransferFunction::preset("grey");
     for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Reference}) {
         RenderSettings s = settingsFor(mode, 1.0, ShadingSettings::ctPreset());
@@ -345,8 +345,8 @@ TEST(ShadingRender, EveryVoxelMinifiedAgainstBruteForce) {
         RenderSettings s = settingsFor(RenderMode::Hybrid, distance, ShadingSettings{});
         const Camera camera = cameraFor(v, s);
         double largest = 0.0;
-        for (auto it = v.grid->tree().cbeginValueOn(); it; ++it) {
-            const openvdb::Vec3d w = v.grid->indexToWorld(it.getCoord());
+        for (auto it = v.tree->cbeginValueOn(); it; ++it) {
+            const openvdb::Vec3d w = v.map->applyMap(it.getCoord().asVec3d());
             const double z = camera.toView(glm::dvec3(w.x(), w.y(), w.z())).z;
             largest = std::max(largest, v.voxelSize * camera.focal() / z);
         }

@@ -104,11 +104,10 @@ inline Volume plainRead(const std::string& file, const std::string& name) {
 }
 
 inline void expectSameVolume(const Volume& want, const Volume& got) {
-    expectSameTree(want.grid->tree(), got.grid->tree());
-    EXPECT_EQ(want.grid->transform(), got.grid->transform());
-    EXPECT_EQ(want.grid->transform().mapType(), got.grid->transform().mapType());
-    EXPECT_EQ(want.grid->getName(), got.grid->getName());
-    EXPECT_EQ(want.grid->getGridClass(), got.grid->getGridClass());
+    expectSameTree(*want.tree, *got.tree);
+    EXPECT_EQ(want.map->type(), got.map->type());
+    EXPECT_TRUE(want.map->isEqual(*got.map));
+    EXPECT_TRUE(sameTransform(want, got));
     EXPECT_EQ(want.name, got.name);
     EXPECT_EQ(want.voxelSize, got.voxelSize);
     EXPECT_EQ(want.indexToWorld, got.indexToWorld);

@@ -87,10 +87,10 @@ TEST(Emission, AttachUnitesTheTopologiesWithTheDensityBackground) {
     ASSERT_TRUE(v.emission);
     EXPECT_EQ(v.emission->outsideDensity, 1u);
     EXPECT_EQ(v.activeVoxels, 3u);
-    EXPECT_EQ(v.grid->tree().activeVoxelCount(), 3u);
-    EXPECT_TRUE(v.grid->tree().isValueOn(openvdb::Coord(5, 0, 0)));
-    EXPECT_EQ(v.grid->tree().getValue(openvdb::Coord(5, 0, 0)), 0.f);
-    EXPECT_EQ(v.grid->tree().getValue(openvdb::Coord(1, 0, 0)), 0.7f);
+    EXPECT_EQ(v.tree->activeVoxelCount(), 3u);
+    EXPECT_TRUE(v.tree->isValueOn(openvdb::Coord(5, 0, 0)));
+    EXPECT_EQ(v.tree->getValue(openvdb::Coord(5, 0, 0)), 0.f);
+    EXPECT_EQ(v.tree->getValue(openvdb::Coord(1, 0, 0)), 0.7f);
     EXPECT_EQ(v.indexBox.max().x(), 5);
     // The value range stays the density's.
     EXPECT_EQ(v.valueMin, 0.7f);

@@ -110,7 +110,7 @@ TEST_F(Grid, SmokeVdbDoubleGridLoads) {
     Volume v = loadVolume(out);
     EXPECT_EQ(v.name, "density");
     EXPECT_EQ(v.activeVoxels, 524288u);
-    EXPECT_EQ(v.grid->activeVoxelCount(), 524288u);
+    EXPECT_EQ(v.tree->activeVoxelCount(), 524288u);
     EXPECT_EQ(v.indexBox, openvdb::CoordBBox(Coord(0, 0, 0), Coord(127, 63, 63)));
     EXPECT_EQ(v.nonFiniteCount, 0u);
     EXPECT_GE(v.valueMin, 0.0f);
@@ -403,7 +403,7 @@ TEST_F(Grid, NonFiniteValuesBecomeZeroAndAreCounted) {
     Volume v = loadVolume(write("nan.vdb", {g}));
     EXPECT_EQ(v.nonFiniteCount, 3u);
     EXPECT_EQ(v.activeVoxels, 5u);
-    auto out = v.grid->getConstAccessor();
+    openvdb::FloatGrid::ConstAccessor out(*v.tree);
     EXPECT_EQ(out.getValue(Coord(0, 0, 0)), 0.0f);
     EXPECT_EQ(out.getValue(Coord(1, 0, 0)), 0.0f);
     EXPECT_EQ(out.getValue(Coord(2, 0, 0)), 0.0f);
@@ -477,7 +477,7 @@ TEST_F(Grid, WriteVolumeIsAtomicAndRoundTrips) {
     writeVolume(out, cb);
     Volume v = loadVolume(out);
     EXPECT_EQ(v.activeVoxels, 8000u);
-    EXPECT_EQ(v.grid->getConstAccessor().getValue(Coord(2, 0, 0)), kCheckerDensityOdd);
+    EXPECT_EQ(openvdb::FloatGrid::ConstAccessor(*v.tree).getValue(Coord(2, 0, 0)), kCheckerDensityOdd);
     size_t files = 0;
     for (const auto& e : fs::directory_iterator(dir_)) files += e.is_regular_file(), (void)e;
     EXPECT_EQ(files, 1u);  // no temporary left behind

@@ -99,7 +99,7 @@ TEST(GridTransferMemory, RoundTripKeepsTreeTransformNameAndLog) {
     EXPECT_EQ(released.back().second, bytes.size());
     auto want = openvdb::FloatGrid::create(std::make_shared<openvdb::FloatTree>(d->tree()));
     Volume sanitized = makeVolume(want, "x.vdb");
-    expectSameTree(sanitized.grid->tree(), got.grid->tree());
+    expectSameTree(*sanitized.tree, got.grid->tree());
     EXPECT_EQ(got.activeVoxels, sanitized.activeVoxels);
     EXPECT_EQ(got.nonFiniteCount, sanitized.nonFiniteCount);
     EXPECT_EQ(got.valueMin, sanitized.valueMin);

@@ -121,7 +121,8 @@ void expectReadAsOpenVdb(const std::string& file, const std::string& name, const
     const std::optional<ReadGrid> got = readVdbGrid(file, asked, &why);
     ASSERT_TRUE(got) << "left to OpenVDB: " << why;
     const Volume want = plainRead(file, name);
-    Volume read = makeVolume(got->grid, file);  // already sanitized: the statistics are the reader's
+    const openvdb::FloatGrid::Ptr grid = toOpenVdbGrid(*got);  // what OpenVDB makes of the same bytes
+    Volume read = makeVolume(grid, file);  // already sanitized: the statistics are the reader's
     read.nonFiniteCount = got->nonFiniteCount;
     read.valueMin = got->valueMin;
     read.valueMax = got->valueMax;
@@ -130,7 +131,13 @@ void expectReadAsOpenVdb(const std::string& file, const std::string& name, const
     openvdb::io::File plain(file);
     plain.open(false);
     const openvdb::GridBase::Ptr base = plain.readGrid(name);
-    expectSameMetadata(*base, *got->grid);  // "is_saved_as_half_float" included, as OpenVDB reads it
+    expectSameMetadata(*base, *grid);  // "is_saved_as_half_float" included, as OpenVDB reads it
+    EXPECT_EQ(base->transform(), grid->transform());
+    EXPECT_EQ(base->transform().mapType(), grid->transform().mapType());
+    // The name and the map readVdbGrid parsed itself (no libopenvdb) are OpenVDB's.
+    EXPECT_EQ(got->name, base->getName());
+    EXPECT_EQ(got->map->type(), base->transform().mapType());
+    EXPECT_TRUE(got->map->isEqual(*base->transform().baseMap()));
     expectSameVolume(want, loadVolume(file, asked));
 }
 
@@ -226,10 +233,10 @@ TEST_F(VdbReader, ChoosesTheGridLoadVolumeChose) {
     const std::string file = write("several.vdb", {vel, flame, density}, openvdb::io::COMPRESS_BLOSC);
     const auto got = readVdbGrid(file, "");
     ASSERT_TRUE(got);
-    EXPECT_EQ(got->grid->getName(), "density");  // by name, wherever it stands
-    EXPECT_EQ(readVdbGrid(file, "flame")->grid->getName(), "flame");
+    EXPECT_EQ(got->name, "density");  // by name, wherever it stands
+    EXPECT_EQ(readVdbGrid(file, "flame")->name, "flame");
     const std::string noDensity = write("flame.vdb", {vel, flame}, openvdb::io::COMPRESS_BLOSC);
-    EXPECT_EQ(readVdbGrid(noDensity, "")->grid->getName(), "flame");  // else the first scalar grid
+    EXPECT_EQ(readVdbGrid(noDensity, "")->name, "flame");  // else the first scalar grid
 }
 
 // What the reader leaves to OpenVDB: nothing returned, the reason given, and loadVolume reads
