@@ -666,7 +666,9 @@ openvdb::MetaMap readMetadata(Cursor& c) {
     } catch (const std::exception& e) {
         c.corrupt("grid metadata (" + std::string(e.what()) + ")");
     }
-    meta.removeMeta(openvdb::GridBase::META_FILE_DELAYED_LOAD);
+    // GridBase::META_FILE_DELAYED_LOAD's value, spelled out: that constant is data in libopenvdb,
+    // which the vdbsplat executable binds lazily, functions only (util/lazy_openvdb.cpp).
+    meta.removeMeta("file_delayed_load");
     return meta;
 }
 
