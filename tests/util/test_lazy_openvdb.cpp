@@ -1,6 +1,7 @@
 // tests/util/test_lazy_openvdb.cpp — util/lazy_openvdb.cpp and its generated trampolines
 // (cmake/lazy_openvdb_trampolines.sh), on the real `vdbsplat` binary: it does not list
-// libopenvdb as NEEDED, a command that never calls into libopenvdb runs without opening it,
+// libopenvdb as NEEDED, commands that never call into libopenvdb (--version, render of a .vdb)
+// run without opening it,
 // commands that do call into it work (exceptions thrown inside libopenvdb included), and a
 // broken installation ends such a command with one error line. With VDBSPLAT_LAZY_OPENVDB OFF
 // the binary links libopenvdb at load time: the tests of the lazy binding itself skip, saying
@@ -131,6 +132,23 @@ TEST_F(LazyOpenvdb, VersionRunsWithoutOpeningLibopenvdb) {
     EXPECT_EQ(r.rc, 0) << r.err;
     EXPECT_NE(r.out.find(VDBSPLAT_VERSION), std::string::npos) << r.out;
     EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST_F(LazyOpenvdb, RenderingAVdbNeverOpensLibopenvdb) {
+    REQUIRE_LAZY_BINDING();
+    // vdbsplat's own reader parses the grid, its name and its map (volume/vdb_types.h), and the
+    // renderer holds the tree: with an unloadable libopenvdb the render still succeeds, and so
+    // does its image through either writer. A call into libopenvdb anywhere on the way would end
+    // in "cannot load" (ALibraryThatCannotBeOpenedIsOneErrorLine).
+    const std::string vdb = sphere();
+    const std::string broken = brokenLibrary("");
+    for (const std::string out : {"r.png", "r.exr"}) {
+        const CliResult r = run("render '" + vdb + "' --size 32x32 --stats '" + scratch_.path("r.json") + "' -o '" +
+                                    scratch_.path(out) + "'",
+                                broken);
+        EXPECT_EQ(r.rc, 0) << out << ": " << r.err;
+        EXPECT_TRUE(fs::exists(scratch_.path(out))) << out;
+    }
 }
 
 TEST_F(LazyOpenvdb, ALibraryThatCannotBeOpenedIsOneErrorLine) {
