@@ -49,6 +49,7 @@
 
 #include "util/error.h"
 #include "volume/grid.h"
+#include "volume/leaf_values.h"
 #include "volume/vdb_check.h"
 #include "volume/vdb_types.h"
 
@@ -401,22 +402,6 @@ private:
     std::string message_;
 };
 
-/// Non-finite values among @p mask's set to 0 and their bits cleared from it (they are not
-/// part of the range); returns how many there were.
-uint64_t zeroNonFinite(float* values, Leaf::NodeMaskType& mask) {
-    uint64_t count = 0;
-    for (uint32_t w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w)
-        for (uint64_t on = mask.getWord<uint64_t>(w); on != 0; on &= on - 1) {
-            const uint32_t b = uint32_t(std::countr_zero(on));
-            float& x = values[64 * w + b];
-            if (std::isfinite(x)) continue;
-            x = 0.0f;
-            ++count;
-            mask.getWord<uint64_t>(w) &= ~(uint64_t(1) << b);
-        }
-    return count;
-}
-
 /// The range of a leaf's active values (all finite), in mask order with std::min/max: the
 /// first of equal extremes wins, as a serial pass over the tree keeps it (only ±0 can tell).
 void exactRange(const float* values, const Leaf::NodeMaskType& mask, float& lo, float& hi) {
@@ -428,34 +413,16 @@ void exactRange(const float* values, const Leaf::NodeMaskType& mask, float& lo, 
         }
 }
 
-/// Stats::active on every active value of a leaf buffer. The range is taken in four
-/// independent lanes (four times the throughput of one dependent min/max chain); which of
-/// two equal extremes it keeps can differ from exactRange only for zeros (+0 and -0), so a
-/// leaf whose extreme is 0 is measured again exactly.
+/// Stats::active on every active value of a leaf buffer: non-finite ones zeroed and counted, the
+/// range of the rest a vector at a time (sanitizeLeafValues, volume/leaf_values.h). Which of two
+/// equal extremes that keeps can differ from exactRange only for zeros (+0 and −0), so a leaf
+/// whose extreme is 0 is measured again exactly.
 void measureActive(float* values, const Leaf::NodeMaskType& active, Stats& s) {
     Leaf::NodeMaskType mask = active;  // less the non-finite values
-    s.nonFinite += zeroNonFinite(values, mask);
-    constexpr float kHigh = std::numeric_limits<float>::max(), kLow = std::numeric_limits<float>::lowest();
-    float lo[4] = {kHigh, kHigh, kHigh, kHigh}, hi[4] = {kLow, kLow, kLow, kLow};
-    uint32_t lane = 0;
-    for (uint32_t w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
-        const float* v = values + 64 * w;
-        const uint64_t on = mask.getWord<uint64_t>(w);
-        if (on == ~uint64_t(0)) {
-            for (uint32_t b = 0; b < 64; b += 4)
-                for (uint32_t j = 0; j < 4; ++j) lo[j] = std::min(lo[j], v[b + j]), hi[j] = std::max(hi[j], v[b + j]);
-            continue;
-        }
-        for (uint64_t bits = on; bits != 0; bits &= bits - 1, lane = (lane + 1) & 3) {
-            const float x = v[std::countr_zero(bits)];
-            lo[lane] = std::min(lo[lane], x);
-            hi[lane] = std::max(hi[lane], x);
-        }
-    }
-    float leafLo = std::min(std::min(lo[0], lo[1]), std::min(lo[2], lo[3]));
-    float leafHi = std::max(std::max(hi[0], hi[1]), std::max(hi[2], hi[3]));
+    float leafLo, leafHi;
+    s.nonFinite += sanitizeLeafValues(values, &mask.getWord<uint64_t>(0), leafLo, leafHi);
     if (leafLo == 0.0f || leafHi == 0.0f) {
-        leafLo = kHigh, leafHi = kLow;
+        leafLo = std::numeric_limits<float>::max(), leafHi = std::numeric_limits<float>::lowest();
         exactRange(values, mask, leafLo, leafHi);
     }
     if (leafLo <= leafHi) {  // any active value: merge in order, the earlier leaf winning ties
