@@ -118,11 +118,6 @@ public:
         if (to < pos_ || to > end_) corrupt(what);
         pos_ = to;
     }
-    /// Back to @p to, a position this cursor has already passed (to read the same bytes again).
-    void rewind(uint64_t to) {
-        if (to > pos_) corrupt("a position ahead");
-        pos_ = to;
-    }
     uint64_t pos() const { return pos_; }
     const char* here() const { return f_->data + pos_; }
     uint64_t left() const { return end_ - pos_; }
@@ -139,18 +134,25 @@ private:
 // ---- file header, metadata, descriptors ----------------------------------------------------
 
 /// Walks a metadata block as OpenVDB's MetaMap::readMeta reads it (a registered fixed-size
-/// type reads its own size, fixedMetadataBytes: it must declare that size, as checkVdbStructure requires).
-void skipMetadata(Cursor& c) {
+/// type reads its own size, fixedMetadataBytes: it must declare that size, as checkVdbStructure
+/// requires), calling @p item(name, type, value) for every item.
+template <class Item>
+void walkMetadata(Cursor& c, Item&& item) {
     const int32_t count = c.get<int32_t>("metadata count");
     if (count < 0 || uint64_t(count) > c.left() / 12) c.corrupt("metadata count");
     for (int32_t i = 0; i < count; ++i) {
-        c.take(c.get<uint32_t>("metadata name"), "metadata name");
+        const uint32_t nameBytes = c.get<uint32_t>("metadata name");
+        const std::string_view name(c.take(nameBytes, "metadata name"), nameBytes);
         const std::string type = c.string("metadata type");
         const uint32_t declared = c.get<uint32_t>("metadata value size");
         const std::optional<uint64_t> fixed = fixedMetadataBytes(type);
         if (fixed && *fixed != declared) c.corrupt("metadata value size");
-        c.take(declared, "metadata value");
+        item(name, type, std::string_view(c.take(declared, "metadata value"), declared));
     }
+}
+
+void skipMetadata(Cursor& c) {
+    walkMetadata(c, [](std::string_view, const std::string&, std::string_view) {});
 }
 
 struct Descriptor {
@@ -610,37 +612,28 @@ openvdb::math::MapBase::Ptr readTransform(Cursor& c, std::string& bytes) {
     }
 }
 
-/// The grid's "name" as GridBase::getName() gives it after MetaMap::readMeta, from a metadata
-/// block skipMetadata has walked (@p bytes gets the block): the last "name" item's string, ""
-/// without one. Blocks MetaMap::readMeta would refuse or read otherwise (an empty item name, an
-/// item name given two types, a non-string "name") are left to OpenVDB.
+/// The grid's "name" as GridBase::getName() gives it after MetaMap::readMeta, from its metadata
+/// block (@p bytes gets the block): the last "name" item's string, "" without one. Blocks
+/// MetaMap::readMeta would refuse or read otherwise (an empty item name, an item name given two
+/// types, a non-string "name") are left to OpenVDB.
 std::string readGridName(Cursor& c, std::string& bytes) {
     const char* start = c.here();
     const uint64_t begin = c.pos();
-    skipMetadata(c);  // every size checked; then the same bytes again, for the names
-    const uint64_t end = c.pos();
-    bytes.assign(start, end - begin);
-    Cursor& m = c;
-    m.rewind(begin);
     std::vector<std::pair<std::string, std::string>> types;  // item name, its type
     std::string name;
-    const int32_t count = m.get<int32_t>("metadata count");
-    for (int32_t i = 0; i < count; ++i) {
-        const std::string item = m.string("metadata name");
-        const std::string type = m.string("metadata type");
-        const uint32_t size = m.get<uint32_t>("metadata value size");
-        const char* value = m.here();
-        m.take(size, "metadata value");
-        if (item.empty()) throw Unsupported{"a metadata item without a name"};
+    const char* unsupported = nullptr;  // after the whole block: a corrupt item is still named as such
+    walkMetadata(c, [&](std::string_view item, const std::string& type, std::string_view value) {
+        if (item.empty()) unsupported = "a metadata item without a name";
         const auto seen = std::find_if(types.begin(), types.end(), [&](const auto& t) { return t.first == item; });
         if (seen == types.end()) types.emplace_back(item, type);
-        else if (seen->second != type) throw Unsupported{"a metadata item given two types"};
+        else if (seen->second != type) unsupported = "a metadata item given two types";
         if (item == "name") {
-            if (type != "string") throw Unsupported{"a grid name that is not a string"};
-            name.assign(value, size);
+            if (type != "string") unsupported = "a grid name that is not a string";
+            name.assign(value);
         }
-    }
-    if (m.pos() != end) m.corrupt("grid metadata");  // cannot happen: skipMetadata walked these bytes
+    });
+    if (unsupported) throw Unsupported{unsupported};
+    bytes.assign(start, c.pos() - begin);
     return name;
 }
 

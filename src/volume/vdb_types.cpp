@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <array>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 #include <vector>
