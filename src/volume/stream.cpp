@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <optional>
 #include <type_traits>
@@ -167,13 +168,14 @@ bool VoxelStream::visible(const Block& b) const {
 void VoxelStream::screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const {
     // Project the corners of the block's box widened by the kernel radius; the margin
     // covers the prefilter. Any corner at or behind the eye plane: the whole screen.
-    const double r = Kernel::kRadius + 0.5;
+    // The map is affine: one corner through it, then the box's three edges as offsets.
+    const double r = Kernel::kRadius + 0.5, side = double(b.dim - 1) + 2.0 * r;
+    const glm::dvec3 low(indexToView_ * glm::dvec4(b.origin.x() - r, b.origin.y() - r, b.origin.z() - r, 1.0));
+    const glm::dmat3 edges = glm::dmat3(indexToView_) * side;
     double lox = 1e300, loy = 1e300, hix = -1e300, hiy = -1e300;
     for (int corner = 0; corner < 8; ++corner) {
-        const glm::dvec3 idx(b.origin.x() + (corner & 1 ? b.dim - 1 + r : -r),
-                             b.origin.y() + (corner & 2 ? b.dim - 1 + r : -r),
-                             b.origin.z() + (corner & 4 ? b.dim - 1 + r : -r));
-        const glm::dvec3 v = camera_.toView(glm::dvec3(volume_.indexToWorld * glm::dvec4(idx, 1.0)));
+        const glm::dvec3 v = low + (corner & 1 ? edges[0] : glm::dvec3(0.0)) + (corner & 2 ? edges[1] : glm::dvec3(0.0)) +
+                             (corner & 4 ? edges[2] : glm::dvec3(0.0));
         if (v.z <= 1e-6) {
             x0 = y0 = 0;
             x1 = camera_.width() - 1;
@@ -306,6 +308,28 @@ float cellRank(const openvdb::Coord& cell, int level) {
 }
 }  // namespace
 
+namespace {
+/// Packs @p count cells in place, keeping those with mass (Σσ > 0 or a voxel counted) in order.
+PackedCells packCells(CellMoments* cells, int count) {
+    uint64_t mask = 0;
+    int kept = 0;
+    for (int i = 0; i < count; ++i)
+        if (cells[i].m > 0.f || cells[i].n != 0) {
+            if (kept != i) cells[kept] = cells[i];
+            ++kept, mask |= uint64_t(1) << i;
+        }
+    return {cells, mask};
+}
+
+/// Room for a block's cells at any level (≤ (8/2)³), left unzeroed (CellMoments zeroes itself).
+struct MomentScratch {
+    union {
+        CellMoments cells[64];
+    };
+    MomentScratch() {}
+};
+}  // namespace
+
 // A block between two levels (lodFine > 0) passes from level k − 1 to level k cell by cell: each
 // cell of level k has a coarse weight w_c that rises from 0 to 1 as the block's weight
 // t = 1 − lodFine does, over its own stretch of t (voxels → 2³: a fraction lodVoxelRamp of it,
@@ -317,11 +341,8 @@ float cellRank(const openvdb::Coord& cell, int level) {
 // is counted once.
 void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const {
     if (b.lodLevel == 0) return extractVoxels(b, nullptr, out);
-    std::array<CellMoments, 64> acc{};  // cells ≤ (8/2)³
-    if (!(b.lodFine > 0.f)) {
-        cellMoments(b, b.lodLevel, acc.data());
-        return emitCells(b, b.lodLevel, acc.data(), nullptr, false, out, counts);
-    }
+    MomentScratch scratch;  // not zeroed: cellMoments fills what it hands back
+    if (!(b.lodFine > 0.f)) return emitCells(b, b.lodLevel, cellMoments(b, b.lodLevel, scratch.cells), nullptr, false, out, counts);
     const int k = b.lodLevel, parents = kBlockDim >> k;
     // From the voxels, cell by cell (drawing a block twice would cost its voxels again); between
     // aggregates, every cell at once (the finer level costs 8× fewer records than the voxels).
@@ -337,42 +358,39 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts)
             }
     if (k == 1) {
         extractVoxels(b, coarse.data(), out);
-    } else {
-        // Level k − 1's moments, emitted for the cells' fine weights, then level k's from them (each
-        // parent the sum of its 8 children, moved from the child's centre to the parent's: d + o).
-        const int level = k - 1, cells = kBlockDim >> level;
-        const float childSide = float(1 << level);
-        cellMoments(b, level, acc.data());
-        std::array<float, 64> parentWeight{};
-        for (int cx = 0; cx < cells; ++cx)
-            for (int cy = 0; cy < cells; ++cy)
-                for (int cz = 0; cz < cells; ++cz)
-                    parentWeight[size_t((cx * cells + cy) * cells + cz)] =
-                        coarse[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
-        emitCells(b, level, acc.data(), parentWeight.data(), true, out, counts);
-        std::array<CellMoments, 64> up{};
-        for (int cx = 0; cx < cells; ++cx)
-            for (int cy = 0; cy < cells; ++cy)
-                for (int cz = 0; cz < cells; ++cz) {
-                    const CellMoments& a = acc[size_t((cx * cells + cy) * cells + cz)];
-                    if (a.n == 0 && !(a.m > 0.f)) continue;
-                    CellMoments& p = up[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
-                    const glm::vec3 o = (glm::vec3(float(cx & 1), float(cy & 1), float(cz & 1)) - 0.5f) * childSide;
-                    p.m += a.m;
-                    p.emission += a.emission;
-                    p.first += a.first + a.m * o;
-                    p.xx += a.xx + 2.f * o.x * a.first.x + a.m * o.x * o.x;
-                    p.yy += a.yy + 2.f * o.y * a.first.y + a.m * o.y * o.y;
-                    p.zz += a.zz + 2.f * o.z * a.first.z + a.m * o.z * o.z;
-                    p.xy += a.xy + o.x * a.first.y + o.y * a.first.x + a.m * o.x * o.y;
-                    p.xz += a.xz + o.x * a.first.z + o.z * a.first.x + a.m * o.x * o.z;
-                    p.yz += a.yz + o.y * a.first.z + o.z * a.first.y + a.m * o.y * o.z;
-                    p.n += a.n;
-                }
-        acc = up;
+        return emitCells(b, 1, cellMoments(b, 1, scratch.cells), coarse.data(), false, out, counts);
     }
-    if (k == 1) cellMoments(b, 1, acc.data());
-    emitCells(b, k, acc.data(), coarse.data(), false, out, counts);
+    // Level k − 1's moments, emitted for the cells' fine weights, then level k's from them (each
+    // parent the sum of its 8 children, moved from the child's centre to the parent's: d + o).
+    const int level = k - 1, cells = kBlockDim >> level;
+    const float childSide = float(1 << level);
+    const PackedCells fine = cellMoments(b, level, scratch.cells);
+    std::array<float, 64> parentWeight{};
+    for (int cx = 0; cx < cells; ++cx)
+        for (int cy = 0; cy < cells; ++cy)
+            for (int cz = 0; cz < cells; ++cz)
+                parentWeight[size_t((cx * cells + cy) * cells + cz)] =
+                    coarse[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
+    emitCells(b, level, fine, parentWeight.data(), true, out, counts);
+    std::array<CellMoments, 64> up{};
+    const CellMoments* child = fine.cells;
+    for (uint64_t bits = fine.mask; bits != 0; bits &= bits - 1, ++child) {
+        const int i = std::countr_zero(bits), cx = i / (cells * cells), cy = (i / cells) % cells, cz = i % cells;
+        const CellMoments& a = *child;
+        CellMoments& p = up[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
+        const glm::vec3 o = (glm::vec3(float(cx & 1), float(cy & 1), float(cz & 1)) - 0.5f) * childSide;
+        p.m += a.m;
+        p.emission += a.emission;
+        p.first += a.first + a.m * o;
+        p.xx += a.xx + 2.f * o.x * a.first.x + a.m * o.x * o.x;
+        p.yy += a.yy + 2.f * o.y * a.first.y + a.m * o.y * o.y;
+        p.zz += a.zz + 2.f * o.z * a.first.z + a.m * o.z * o.z;
+        p.xy += a.xy + o.x * a.first.y + o.y * a.first.x + a.m * o.x * o.y;
+        p.xz += a.xz + o.x * a.first.z + o.z * a.first.x + a.m * o.x * o.z;
+        p.yz += a.yz + o.y * a.first.z + o.z * a.first.y + a.m * o.y * o.z;
+        p.n += a.n;
+    }
+    emitCells(b, k, packCells(up.data(), parents * parents * parents), coarse.data(), false, out, counts);
 }
 
 // coarse: per level-1 cell (x>>1, y>>1, z>>1) its weight w_c at level 1; the voxels take 1 − w_c
@@ -486,25 +504,45 @@ void VoxelStream::prepareMomentCache(size_t blocks) {
         const bool kept = level >= 2 || cache.level1;
         std::remove_reference_t<decltype(cache.cells[0])>().swap(cache.cells[level - 1]);  // the old grid's slots go
         cache.cells[level - 1].resize(kept ? blocks * cells : 0);
+        cache.offset[level - 1].resize(kept ? blocks : 0);
+        cache.mask[level - 1].resize(kept ? blocks : 0);
         cache.have[level - 1].assign(kept ? blocks : 0, 0);
+        cache.cursor[size_t(level - 1)].store(0, std::memory_order_relaxed);
     }
 }
 
 // Through the kept slots where there are (each block is extracted by one thread, so a slot is
 // written by one and read in a later render, after the parallel passes that separate them).
-void VoxelStream::cellMoments(const Block& b, int level, CellMoments* acc) const {
-    if (!moments_ || level < 1 || level > 3 || (level == 1 && !moments_->level1) || b.dim != kBlockDim)
-        return computeCellMoments(b, level, acc);
+// A block drawn at one level whose cells are kept: its extraction reads no voxel.
+bool VoxelStream::momentsKept(const Block& b) const {
+    const int level = b.lodLevel;
+    return moments_ && level >= 1 && level <= 3 && !(b.lodFine > 0.f) && b.dim == kBlockDim &&
+           (level > 1 || moments_->level1) && moments_->have[size_t(level - 1)][b.id];
+}
+
+// Read in place, packed: a copy of a level-2 block's 64 cells into a zeroed array was 8.6 KB of
+// memory traffic per block, and the kept cells whole 16 MB per far Engine render, 8 in 9 empty.
+PackedCells VoxelStream::cellMoments(const Block& b, int level, CellMoments* scratch) const {
+    const int count = (b.dim >> level) * (b.dim >> level) * (b.dim >> level);
+    if (!moments_ || level < 1 || level > 3 || (level == 1 && !moments_->level1) || b.dim != kBlockDim) {
+        std::fill_n(scratch, count, CellMoments{});  // the sums start from zero
+        computeCellMoments(b, level, scratch);
+        return packCells(scratch, count);
+    }
     LodMomentCache& cache = *moments_;
-    const size_t cells = size_t(kBlockDim >> level) * size_t(kBlockDim >> level) * size_t(kBlockDim >> level);
-    CellMoments* slot = cache.cells[level - 1].data() + size_t(b.id) * cells;
-    uint8_t& have = cache.have[level - 1][b.id];
+    const size_t l = size_t(level - 1);
+    uint8_t& have = cache.have[l][b.id];
     if (!have) {
-        std::fill_n(slot, cells, CellMoments{});  // the sums start from zero
-        computeCellMoments(b, level, slot);
+        std::fill_n(scratch, count, CellMoments{});
+        computeCellMoments(b, level, scratch);
+        const PackedCells packed = packCells(scratch, count);
+        const size_t n = size_t(std::popcount(packed.mask));
+        const size_t at = cache.cursor[l].fetch_add(n, std::memory_order_relaxed);  // ≤ blocks × cells in all
+        std::copy_n(packed.cells, n, cache.cells[l].data() + at);
+        cache.offset[l][b.id] = uint32_t(at), cache.mask[l][b.id] = packed.mask;
         have = 1;
     }
-    std::copy_n(slot, cells, acc);
+    return {cache.cells[l].data() + cache.offset[l][b.id], cache.mask[l][b.id]};
 }
 
 void VoxelStream::computeCellMoments(const Block& b, int level, CellMoments* acc) const {
@@ -550,64 +588,69 @@ void VoxelStream::computeCellMoments(const Block& b, int level, CellMoments* acc
 // coarse: per cell of this level (fineSide: of the level above), the coarse weight w_c; the cell
 // takes w_c (fineSide: 1 − w_c; nothing where that is 0) and carries its count where w_c ≥ ½
 // (fineSide: < ½). nullptr: weight 1, counted.
-void VoxelStream::emitCells(const Block& b, int level, const CellMoments* acc, const float* coarse, bool fineSide,
+void VoxelStream::emitCells(const Block& b, int level, PackedCells acc, const float* coarse, bool fineSide,
                             VoxelBatch& out, StreamCounts& counts) const {
-    using Moments = CellMoments;
     const int side = 1 << level, cells = b.dim >> level;
+    // In float about the block: its first cell's centre in view space once (double, as every
+    // record's position), then per cell offsets of at most 8 voxels through the linear part A. (In
+    // double throughout, the cells' conversions and divisions were 12 % of a far render's CPU.)
     const float half = 0.5f * float(side - 1);
-    const glm::dmat3 toView(indexToView_);  // linear part: index offsets → view offsets
-    const double f = camera_.focal();
-    // Sized for every cell first, written by index, cut to the cells kept (as extractVoxels; it
-    // also marks the batch's depth spreads kept or not, as every other record path does).
+    const glm::dvec3 firstCentre = glm::dvec3(b.origin.x(), b.origin.y(), b.origin.z()) + double(half);
+    const glm::vec3 origin(indexToView_ * glm::dvec4(firstCentre, 1.0));
+    const glm::mat3 toView{glm::dmat3(indexToView_)};  // linear part: index offsets → view offsets
+    const float f = float(camera_.focal());
+    // A full cell's own second moment, s²·(n² − 1)/12 per index axis (see below).
+    const float fullMoment = (float(side) * float(side) - 1.f) / 12.f;
+    // Sized for the cells kept, written by index (it also marks the batch's depth spreads kept or
+    // not, as every other record path does); cut to those drawn.
     size_t k = out.size();
     out.withDepthSpread = options_.depthSpread;
-    out.resize(k + size_t(cells * cells * cells));
-    for (int cx = 0; cx < cells; ++cx)
-        for (int cy = 0; cy < cells; ++cy)
-            for (int cz = 0; cz < cells; ++cz) {
-                const Moments& a = acc[size_t((cx * cells + cy) * cells + cz)];
-                if (!(a.m > 0.f)) continue;
-                const float c = coarse ? coarse[size_t((cx * cells + cy) * cells + cz)] : 1.f;
-                const float weight = fineSide ? 1.f - c : c;
-                const bool counted = fineSide ? c < 0.5f : c >= 0.5f;
-                if (!(weight > 0.f)) continue;
-                const glm::dvec3 mu = glm::dvec3(a.first) / double(a.m);
-                const glm::dvec3 centreIdx = glm::dvec3(b.origin.x() + cx * side, b.origin.y() + cy * side,
-                                                        b.origin.z() + cz * side) + double(half) + mu;
-                const glm::dvec3 v(indexToView_ * glm::dvec4(centreIdx, 1.0));
-                // Covariance about μ (index units²), then in view space: Σ_v = A Σ Aᵀ.
-                const double im = 1.0 / a.m;
-                glm::dmat3 cov;
-                cov[0][0] = a.xx * im - mu.x * mu.x, cov[1][1] = a.yy * im - mu.y * mu.y, cov[2][2] = a.zz * im - mu.z * mu.z;
-                cov[0][1] = cov[1][0] = a.xy * im - mu.x * mu.y;
-                cov[0][2] = cov[2][0] = a.xz * im - mu.x * mu.z;
-                cov[1][2] = cov[2][1] = a.yz * im - mu.y * mu.z;
-                // Projected (Jacobian of the perspective map at μ, EWA 2001 eq. 25): J = f/z [I | −v.xy/z];
-                // the spread is trace(J A Σ Aᵀ Jᵀ)/2 = Σ over the rows j of J of (Aᵀj)ᵀ Σ (Aᵀj).
-                const glm::dvec3 jx(f / v.z, 0.0, -f * v.x / (v.z * v.z)), jy(0.0, f / v.z, -f * v.y / (v.z * v.z));
-                const glm::dvec3 ux = jx * toView, uy = jy * toView;  // row vector · A = Aᵀj
-                const double spread = 0.5 * (glm::dot(ux, cov * ux) + glm::dot(uy, cov * uy));
-                out.viewPos[k] = glm::vec3(v);
-                out.distance[k] = float(glm::length(v));
-                out.sigma[k] = weight == 1.f ? a.m : a.m * weight;
-                out.color[k] = a.emission / a.m;
-                // Only what exceeds a full cell's own second moment (s²·(n² − 1)/12 per index axis)
-                // is added: the cells' lattice already spreads a full cell's mass over the cell, as
-                // the voxels' lattice does a voxel's (a uniform region of cells is the same quadrature
-                // of the same field as its voxels, one level coarser). Adding it again blurred every
-                // surface by a cell (docs/animation.md, session 5).
-                const double full = (double(side) * side - 1.0) / 12.0 * 0.5 * (glm::dot(ux, ux) + glm::dot(uy, uy));
-                out.spread[k] = float(std::max(spread - full, 0.0));
-                // Along the view ray the whole second moment counts (world²): the depth profile of the
-                // cell's mass (--compositing slabs, composite/slab_profile.h), ωᵀ A Σ Aᵀ ω.
-                if (options_.depthSpread) {
-                    const glm::dvec3 uz = (v / glm::length(v)) * toView;
-                    out.depthSpread[k] = float(std::max(glm::dot(uz, cov * uz), 0.0));
-                }
-                out.members[k] = counted ? a.n : 0;
-                ++k;
-                if (counted) ++counts.aggregates, counts.aggregatedVoxels += a.n;
-            }
+    out.resize(k + size_t(std::popcount(acc.mask)));
+    const CellMoments* cell = acc.cells;
+    for (uint64_t bits = acc.mask; bits != 0; bits &= bits - 1) {
+        const CellMoments& a = *cell++;
+        const int i = std::countr_zero(bits), cx = i / (cells * cells), cy = (i / cells) % cells, cz = i % cells;
+        if (!(a.m > 0.f)) continue;
+        const float c = coarse ? coarse[size_t(i)] : 1.f;
+        const float weight = fineSide ? 1.f - c : c;
+        const bool counted = fineSide ? c < 0.5f : c >= 0.5f;
+        if (!(weight > 0.f)) continue;
+        const float im = 1.f / a.m;
+        const glm::vec3 mu = a.first * im;  // σ-weighted centroid about the cell's centre
+        const glm::vec3 v = origin + toView * (glm::vec3(float(cx * side), float(cy * side), float(cz * side)) + mu);
+        // Covariance about μ (index units²), then in view space: Σ_v = A Σ Aᵀ.
+        glm::mat3 cov;
+        cov[0][0] = a.xx * im - mu.x * mu.x, cov[1][1] = a.yy * im - mu.y * mu.y, cov[2][2] = a.zz * im - mu.z * mu.z;
+        cov[0][1] = cov[1][0] = a.xy * im - mu.x * mu.y;
+        cov[0][2] = cov[2][0] = a.xz * im - mu.x * mu.z;
+        cov[1][2] = cov[2][1] = a.yz * im - mu.y * mu.z;
+        // Projected (Jacobian of the perspective map at μ, EWA 2001 eq. 25): J = f/z [I | −v.xy/z];
+        // the spread is trace(J A Σ Aᵀ Jᵀ)/2 = Σ over the rows j of J of (Aᵀj)ᵀ Σ (Aᵀj).
+        const float fz = f / v.z;
+        const glm::vec3 jx(fz, 0.f, -fz * v.x / v.z), jy(0.f, fz, -fz * v.y / v.z);
+        const glm::vec3 ux = jx * toView, uy = jy * toView;  // row vector · A = Aᵀj
+        const float spread = 0.5f * (glm::dot(ux, cov * ux) + glm::dot(uy, cov * uy));
+        out.viewPos[k] = v;
+        out.distance[k] = glm::length(v);
+        out.sigma[k] = weight == 1.f ? a.m : a.m * weight;
+        out.color[k] = a.emission * im;
+        // Only what exceeds a full cell's own second moment (s²·(n² − 1)/12 per index axis)
+        // is added: the cells' lattice already spreads a full cell's mass over the cell, as
+        // the voxels' lattice does a voxel's (a uniform region of cells is the same quadrature
+        // of the same field as its voxels, one level coarser). Adding it again blurred every
+        // surface by a cell (docs/animation.md, session 5).
+        const float full = fullMoment * 0.5f * (glm::dot(ux, ux) + glm::dot(uy, uy));
+        out.spread[k] = std::max(spread - full, 0.f);
+        // Along the view ray the whole second moment counts (world²): the depth profile of the
+        // cell's mass (--compositing slabs, composite/slab_profile.h), ωᵀ A Σ Aᵀ ω.
+        if (options_.depthSpread) {
+            const glm::vec3 uz = (v / glm::length(v)) * toView;
+            out.depthSpread[k] = std::max(glm::dot(uz, cov * uz), 0.f);
+        }
+        out.members[k] = counted ? a.n : 0;
+        ++k;
+        if (counted) ++counts.aggregates, counts.aggregatedVoxels += a.n;
+    }
     out.resize(k);
 }
 
@@ -750,7 +793,7 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                 for (size_t j = c * kExtractChunk; j < chunkEnd; ++j) {
                     const size_t i = first + j;
                     const Block& b = blocks_[i];
-                    if (j + 1 < chunkEnd && blocks_[i + 1].leaf) {
+                    if (j + 1 < chunkEnd && blocks_[i + 1].leaf && !momentsKept(blocks_[i + 1])) {
                         const char* next = reinterpret_cast<const char*>(blocks_[i + 1].leaf->buffer().data());
                         for (int line = 0; line < 32; ++line) __builtin_prefetch(next + 64 * line);
                     }

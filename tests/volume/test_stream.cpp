@@ -383,8 +383,15 @@ TEST(Stream, KeptMomentsAreReadAndFollowTheTable) {
     for (int level = 0; level < 3; ++level)
         for (uint8_t h : kept.moments.have[level]) filled += h;
     ASSERT_GT(filled, 100u);
-    for (auto& cells : kept.moments.cells)
-        for (CellMoments& c : cells) c.m *= 2.f, c.emission *= 2.f;  // spoiled: twice the mass
+    for (int level = 0; level < 3; ++level) {  // the cells claimed (packed: those with mass only)
+        const size_t claimed = kept.moments.cursor[size_t(level)].load();
+        ASSERT_LE(claimed, kept.moments.cells[level].size());
+        for (size_t i = 0; i < claimed; ++i) {
+            CellMoments& c = kept.moments.cells[level][i];
+            EXPECT_TRUE(c.m > 0.f || c.n != 0);        // no empty cell is kept
+            c.m *= 2.f, c.emission *= 2.f;             // spoiled: twice the mass
+        }
+    }
     const Camera far = framedCamera(v, 256, 8.0);
     EXPECT_NE(streamRecords(v, far, a, &kept), streamRecords(v, far, a, nullptr));
     EXPECT_EQ(streamRecords(v, far, b, &kept), streamRecords(v, far, b, nullptr));  // another table: emptied
