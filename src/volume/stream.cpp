@@ -309,16 +309,12 @@ float cellRank(const openvdb::Coord& cell, int level) {
 }  // namespace
 
 namespace {
-/// Packs @p count cells in place, keeping those with mass (Σσ > 0 or a voxel counted) in order.
-PackedCells packCells(CellMoments* cells, int count) {
+/// The @p count cells at @p cells, those with mass (Σσ > 0 or a voxel counted) marked, in place.
+PackedCells cellsWithMass(const CellMoments* cells, int count) {
     uint64_t mask = 0;
-    int kept = 0;
     for (int i = 0; i < count; ++i)
-        if (cells[i].m > 0.f || cells[i].n != 0) {
-            if (kept != i) cells[kept] = cells[i];
-            ++kept, mask |= uint64_t(1) << i;
-        }
-    return {cells, mask};
+        if (cells[i].m > 0.f || cells[i].n != 0) mask |= uint64_t(1) << i;
+    return {cells, mask, false};
 }
 
 /// Room for a block's cells at any level (≤ (8/2)³), left unzeroed (CellMoments zeroes itself).
@@ -373,10 +369,10 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts)
                     coarse[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
     emitCells(b, level, fine, parentWeight.data(), true, out, counts);
     std::array<CellMoments, 64> up{};
-    const CellMoments* child = fine.cells;
-    for (uint64_t bits = fine.mask; bits != 0; bits &= bits - 1, ++child) {
+    int j = 0;
+    for (uint64_t bits = fine.mask; bits != 0; bits &= bits - 1, ++j) {
         const int i = std::countr_zero(bits), cx = i / (cells * cells), cy = (i / cells) % cells, cz = i % cells;
-        const CellMoments& a = *child;
+        const CellMoments& a = fine.at(i, j);
         CellMoments& p = up[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
         const glm::vec3 o = (glm::vec3(float(cx & 1), float(cy & 1), float(cz & 1)) - 0.5f) * childSide;
         p.m += a.m;
@@ -390,7 +386,7 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts)
         p.yz += a.yz + o.y * a.first.z + o.z * a.first.y + a.m * o.y * o.z;
         p.n += a.n;
     }
-    emitCells(b, k, packCells(up.data(), parents * parents * parents), coarse.data(), false, out, counts);
+    emitCells(b, k, cellsWithMass(up.data(), parents * parents * parents), coarse.data(), false, out, counts);
 }
 
 // coarse: per level-1 cell (x>>1, y>>1, z>>1) its weight w_c at level 1; the voxels take 1 − w_c
@@ -527,7 +523,7 @@ PackedCells VoxelStream::cellMoments(const Block& b, int level, CellMoments* scr
     if (!moments_ || level < 1 || level > 3 || (level == 1 && !moments_->level1) || b.dim != kBlockDim) {
         std::fill_n(scratch, count, CellMoments{});  // the sums start from zero
         computeCellMoments(b, level, scratch);
-        return packCells(scratch, count);
+        return cellsWithMass(scratch, count);
     }
     LodMomentCache& cache = *moments_;
     const size_t l = size_t(level - 1);
@@ -535,11 +531,11 @@ PackedCells VoxelStream::cellMoments(const Block& b, int level, CellMoments* scr
     if (!have) {
         std::fill_n(scratch, count, CellMoments{});
         computeCellMoments(b, level, scratch);
-        const PackedCells packed = packCells(scratch, count);
-        const size_t n = size_t(std::popcount(packed.mask));
-        const size_t at = cache.cursor[l].fetch_add(n, std::memory_order_relaxed);  // ≤ blocks × cells in all
-        std::copy_n(packed.cells, n, cache.cells[l].data() + at);
-        cache.offset[l][b.id] = uint32_t(at), cache.mask[l][b.id] = packed.mask;
+        const PackedCells found = cellsWithMass(scratch, count);
+        const size_t at = cache.cursor[l].fetch_add(size_t(std::popcount(found.mask)), std::memory_order_relaxed);
+        CellMoments* kept = cache.cells[l].data() + at;  // ≤ blocks × cells claimed in all
+        for (uint64_t bits = found.mask; bits != 0; bits &= bits - 1) *kept++ = scratch[std::countr_zero(bits)];
+        cache.offset[l][b.id] = uint32_t(at), cache.mask[l][b.id] = found.mask;
         have = 1;
     }
     return {cache.cells[l].data() + cache.offset[l][b.id], cache.mask[l][b.id]};
@@ -606,10 +602,10 @@ void VoxelStream::emitCells(const Block& b, int level, PackedCells acc, const fl
     size_t k = out.size();
     out.withDepthSpread = options_.depthSpread;
     out.resize(k + size_t(std::popcount(acc.mask)));
-    const CellMoments* cell = acc.cells;
+    int j = 0;
     for (uint64_t bits = acc.mask; bits != 0; bits &= bits - 1) {
-        const CellMoments& a = *cell++;
         const int i = std::countr_zero(bits), cx = i / (cells * cells), cy = (i / cells) % cells, cz = i % cells;
+        const CellMoments& a = acc.at(i, j++);
         if (!(a.m > 0.f)) continue;
         const float c = coarse ? coarse[size_t(i)] : 1.f;
         const float weight = fineSide ? 1.f - c : c;

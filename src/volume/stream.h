@@ -173,11 +173,15 @@ struct LodMomentCache {
     std::vector<uint8_t> have[3];       ///< per level and block id: the slot is filled
     std::unique_ptr<std::atomic<size_t>[]> cursor = std::make_unique<std::atomic<size_t>[]>(3);  ///< per level: cells claimed
 };
-/// @brief The cells of a block with mass (Σσ > 0 or a voxel counted), in cell order: cell i of the
-/// block ((cx·c + cy)·c + cz) is present iff bit i of @p mask is set, at cells[popcount of the bits below].
+/// @brief The cells of a block with mass (Σσ > 0 or a voxel counted): cell i of the block
+/// ((cx·c + cy)·c + cz) is present iff bit i of @p mask is set, and is cells[j], j the number of
+/// set bits below i (packed), or cells[i] (every cell of the block in place).
 struct PackedCells {
     const CellMoments* cells = nullptr;
     uint64_t mask = 0;
+    bool packed = true;
+    /// The present cell of bit @p i, the @p j-th present one.
+    const CellMoments& at(int i, int j) const { return cells[packed ? j : i]; }
 };
 
 /// @brief The stream's voxel buffers. A caller rendering many images keeps them from one render
