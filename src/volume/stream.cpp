@@ -494,12 +494,14 @@ void VoxelStream::prepareMomentCache(size_t blocks) {
     key = fnv1a64(&path, sizeof path, key) | 1;  // never 0 (none yet)
     if (cache.key == key && cache.blocks == blocks) return;
     cache.key = key, cache.blocks = blocks;
-    cache.level1 = blocks * 64 * sizeof(CellMoments) <= LodMomentCache::kLevel1Budget;
+    // Packed, a level holds at most one cell per active voxel.
+    const auto room = [&](size_t cells) { return std::min<size_t>(blocks * cells, volume_.activeVoxels); };
+    cache.level1 = room(64) * sizeof(CellMoments) <= LodMomentCache::kLevel1Budget;
     for (int level = 1; level <= 3; ++level) {
         const size_t cells = size_t(kBlockDim >> level) * size_t(kBlockDim >> level) * size_t(kBlockDim >> level);
         const bool kept = level >= 2 || cache.level1;
         std::remove_reference_t<decltype(cache.cells[0])>().swap(cache.cells[level - 1]);  // the old grid's slots go
-        cache.cells[level - 1].resize(kept ? blocks * cells : 0);
+        cache.cells[level - 1].resize(kept ? room(cells) : 0);
         cache.offset[level - 1].resize(kept ? blocks : 0);
         cache.mask[level - 1].resize(kept ? blocks : 0);
         cache.have[level - 1].assign(kept ? blocks : 0, 0);
@@ -516,8 +518,7 @@ bool VoxelStream::momentsKept(const Block& b) const {
            (level > 1 || moments_->level1) && moments_->have[size_t(level - 1)][b.id];
 }
 
-// Read in place, packed: a copy of a level-2 block's 64 cells into a zeroed array was 8.6 KB of
-// memory traffic per block, and the kept cells whole 16 MB per far Engine render, 8 in 9 empty.
+// Read in place: the kept cells were copied into a zeroed array of 64 cells (3.6 KB) per block.
 PackedCells VoxelStream::cellMoments(const Block& b, int level, CellMoments* scratch) const {
     const int count = (b.dim >> level) * (b.dim >> level) * (b.dim >> level);
     if (!moments_ || level < 1 || level > 3 || (level == 1 && !moments_->level1) || b.dim != kBlockDim) {
