@@ -120,7 +120,7 @@ struct RenderSettings {
     /// 2, 4 or 8 voxels per side whose side projects to at most this many pixels; 0: off.
     /// 1.25 (it was 1): a 2³ cell of 0.6 px voxels (a 1024² far view) is aggregated; within the
     /// cap the spread a cell adds beside the points' filter decides (kLodMaxSpreadRatio,
-    /// volume/stream.h), so an 8³ cell of 0.15 px voxels is not (docs/performance.md, session 3).
+    /// volume/stream.h; docs/performance.md, sessions 3 and 20).
     double lodPx = 1.25;
     /// How blocks pass from one level of detail to the next (volume/stream.h LodBlend, kLodPassage):
     /// On, blended as the camera moves (no pop in a zoom); Off, each block switches at once where a

@@ -64,13 +64,18 @@ struct VoxelBatch {
     void reserve(size_t n, bool depthSpreads);  ///< room for @p n records in every array (no pages touched)
 };
 
-/// Level of detail: the largest spread an aggregate may add, as a fraction of the filter
-/// variance of the points it replaces. An aggregate keeps the energy and the second moment, but
-/// not the order of its voxels in depth nor the lumps of their separate footprints; where the
-/// spread is small beside the filter neither shows. Measured (far views, postfilter, PSNR
-/// against the reference, each level against --lod 0): ratios 0.22–0.54 cost −0.7…+0.5 dB,
-/// ratios 1.1–2.3 cost −0.4…−8.7 dB (docs/performance.md, session 3).
-inline constexpr double kLodMaxSpreadRatio = 0.75;
+/// Level of detail: the largest spread a uniform cell would add, s²(n² − 1)/12, as a fraction of
+/// the filter variance of the points it replaces. An aggregate keeps the energy and the second
+/// moment, but not the order of its voxels in depth nor the lumps of their separate footprints;
+/// where the cell is small beside the filter neither shows. 1.25 (session 20; it was 0.75 from
+/// session 3, when an aggregate still added its whole second moment: ratios 1.1–2.3 then cost
+/// −0.4…−8.7 dB). Since session 5 a cell adds only what exceeds a full cell's own moment, and
+/// against the `--spp 16` references (400², docs/performance.md, session 20) 1.25 takes the
+/// Engine's far view from blended 4³/8³ cells (31 277 points) to 8³ cells (4 435) at +0.32 dB,
+/// the checker box far +0.85 dB, the tubes +0.61 dB, Marschner–Lobb the same; the checker box at
+/// --distance 6 loses 0.98 dB (57.83 → 56.85, 4³ instead of 2³ cells; without level of detail
+/// 53.84). Above ~1.2 the cell size (--lod) decides at these views; larger --lod costs up to 4 dB.
+inline constexpr double kLodMaxSpreadRatio = 1.25;
 /// Level of detail, blended: passage k (ℓ from .first to .second, ℓ = the admissible level of a
 /// block, log₂ of the cell size in voxels) takes a block from level k − 1 to level k (voxels,
 /// 2³, 4³, 8³). The first starts where 2³ becomes admissible and is long (a zoom passes it over

@@ -441,7 +441,7 @@ TEST(Stream, BlendedLevelsKeepTheEnergy) {
     };
     // Voxel spacing from ≈ 0.8 px (no aggregate) to ≈ 0.02 px (8³ cells): every passage.
     int passing = 0, stillSwitched = 0, stillBlended = 0;
-    for (double distance = 0.12; distance < 6.0; distance *= 1.17) {
+    for (double distance = 0.12; distance < 6.0; distance *= 1.12) {  // ~10 views inside passages
         const Drawn d = draw(distance, LodBlend::On);
         EXPECT_NEAR(d.mass / voxelMass, 1.0, 2e-5) << "distance " << distance;
         EXPECT_EQ(d.members, voxelCount) << "distance " << distance;
