@@ -509,19 +509,21 @@ void VoxelStream::prepareMomentCache(size_t blocks) {
     }
 }
 
-// Through the kept slots where there are (each block is extracted by one thread, so a slot is
-// written by one and read in a later render, after the parallel passes that separate them).
-// A block drawn at one level whose cells are kept: its extraction reads no voxel.
-bool VoxelStream::momentsKept(const Block& b) const {
-    const int level = b.lodLevel;
-    return moments_ && level >= 1 && level <= 3 && !(b.lodFine > 0.f) && b.dim == kBlockDim &&
-           (level > 1 || moments_->level1) && moments_->have[size_t(level - 1)][b.id];
+bool VoxelStream::keepsLevel(const Block& b, int level) const {
+    return moments_ && level >= 1 && level <= 3 && (level > 1 || moments_->level1) && b.dim == kBlockDim;
 }
 
-// Read in place: the kept cells were copied into a zeroed array of 64 cells (3.6 KB) per block.
+// A block drawn at one level whose cells are kept: its extraction reads no voxel.
+bool VoxelStream::momentsKept(const Block& b) const {
+    return !(b.lodFine > 0.f) && keepsLevel(b, b.lodLevel) && moments_->have[size_t(b.lodLevel - 1)][b.id];
+}
+
+// Through the kept slots where there are (each block is extracted by one thread, so a slot is
+// written by one and read in a later render, after the parallel passes that separate them), read
+// in place (they were copied into a zeroed array of 64 cells, 3.6 KB, per block).
 PackedCells VoxelStream::cellMoments(const Block& b, int level, CellMoments* scratch) const {
     const int count = (b.dim >> level) * (b.dim >> level) * (b.dim >> level);
-    if (!moments_ || level < 1 || level > 3 || (level == 1 && !moments_->level1) || b.dim != kBlockDim) {
+    if (!keepsLevel(b, level)) {
         std::fill_n(scratch, count, CellMoments{});  // the sums start from zero
         computeCellMoments(b, level, scratch);
         return cellsWithMass(scratch, count);
@@ -627,8 +629,9 @@ void VoxelStream::emitCells(const Block& b, int level, PackedCells acc, const fl
         const glm::vec3 jx(fz, 0.f, -fz * v.x / v.z), jy(0.f, fz, -fz * v.y / v.z);
         const glm::vec3 ux = jx * toView, uy = jy * toView;  // row vector · A = Aᵀj
         const float spread = 0.5f * (glm::dot(ux, cov * ux) + glm::dot(uy, cov * uy));
+        const float distance = glm::length(v);
         out.viewPos[k] = v;
-        out.distance[k] = glm::length(v);
+        out.distance[k] = distance;
         out.sigma[k] = weight == 1.f ? a.m : a.m * weight;
         out.color[k] = a.emission * im;
         // Only what exceeds a full cell's own second moment (s²·(n² − 1)/12 per index axis)
@@ -641,7 +644,7 @@ void VoxelStream::emitCells(const Block& b, int level, PackedCells acc, const fl
         // Along the view ray the whole second moment counts (world²): the depth profile of the
         // cell's mass (--compositing slabs, composite/slab_profile.h), ωᵀ A Σ Aᵀ ω.
         if (options_.depthSpread) {
-            const glm::vec3 uz = (v / glm::length(v)) * toView;
+            const glm::vec3 uz = (v / distance) * toView;
             out.depthSpread[k] = std::max(glm::dot(uz, cov * uz), 0.f);
         }
         out.members[k] = counted ? a.n : 0;

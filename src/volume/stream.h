@@ -74,7 +74,7 @@ struct VoxelBatch {
 /// Engine's far view from blended 4³/8³ cells (31 277 points) to 8³ cells (4 435) at +0.32 dB,
 /// the checker box far +0.85 dB, the tubes +0.61 dB, Marschner–Lobb the same; the checker box at
 /// --distance 6 loses 0.98 dB (57.83 → 56.85, 4³ instead of 2³ cells; without level of detail
-/// 53.84). Above ~1.2 the cell size (--lod) decides at these views; larger --lod costs up to 4 dB.
+/// 53.84). Above ~1.2 the cell size (--lod) decides at these views; a larger --lod costs 0.8–11 dB.
 inline constexpr double kLodMaxSpreadRatio = 1.25;
 /// Level of detail, blended: passage k (ℓ from .first to .second, ℓ = the admissible level of a
 /// block, log₂ of the cell size in voxels) takes a block from level k − 1 to level k (voxels,
@@ -178,6 +178,7 @@ struct LodMomentCache {
     std::vector<uint8_t> have[3];       ///< per level and block id: the slot is filled
     std::unique_ptr<std::atomic<size_t>[]> cursor = std::make_unique<std::atomic<size_t>[]>(3);  ///< per level: cells claimed
 };
+
 /// @brief The cells of a block with mass (Σσ > 0 or a voxel counted): cell i of the block
 /// ((cx·c + cy)·c + cz) is present iff bit i of @p mask is set, and is cells[j], j the number of
 /// set bits below i (packed), or cells[i] (every cell of the block in place).
@@ -242,8 +243,10 @@ private:
     static size_t recordsOf(const Block& b);  // about how many records b's extraction gives
     void extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const;  // counts: aggregates only
     void extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const;
-    /// The moments of @p b's cells at @p level, packed: its kept slots, or @p scratch (64 cells) filled.
+    /// The moments of @p b's cells at @p level: its kept slots (packed), or @p scratch (room for 64
+    /// cells) filled and marked in place.
     PackedCells cellMoments(const Block& b, int level, CellMoments* scratch) const;
+    bool keepsLevel(const Block& b, int level) const;  // this level's cells of b are kept between renders
     bool momentsKept(const Block& b) const;  // drawn at one level from kept cells (reads no voxel)
     void computeCellMoments(const Block& b, int level, CellMoments* acc) const;
     void prepareMomentCache(size_t blocks);  // keys (or empties) the kept moments for this grid and table

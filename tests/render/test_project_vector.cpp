@@ -270,7 +270,9 @@ TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
         EXPECT_EQ(a.drawnVoxels, b.drawnVoxels);
         EXPECT_EQ(a.lodAggregates, b.lodAggregates);
         EXPECT_GT(a.points, 1000);  // both lane paths are exercised (point mode: points alone)
-        if (mode == RenderMode::Hybrid) EXPECT_GT(a.splats, 1000);
+        if (mode == RenderMode::Hybrid) {
+            EXPECT_GT(a.splats, 1000);
+        }
         ASSERT_EQ(lanes.size, scalar.size);
         for (size_t i = 0; i < lanes.size; ++i) {
             ASSERT_EQ(lanes.order[i], scalar.order[i]) << i;
