@@ -133,6 +133,9 @@ struct StreamOptions {
     /// Whole-leaf aggregates (8³ cells) through the vectorised sums (volume/leaf_moments.h);
     /// false: the scalar row sums they are tested against (same moments to float rounding).
     bool vectorLeafMoments = true;
+    /// Level-of-detail cells' records through the vectorised form (volume/cell_records.h); false:
+    /// one cell at a time, the oracle (the same records, bit for bit).
+    bool vectorCells = true;
     /// Plain leaves' voxels through the vectorised extraction (volume/leaf_extract.h); false: the
     /// voxel-by-voxel path it is tested against (the same records, bit for bit).
     bool vectorExtract = true;
