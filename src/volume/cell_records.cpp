@@ -29,13 +29,17 @@ void CellRecordsImpl(const CellFrame& frame, CellLanes& L, int n) {
     // (x + y) + z: glm's dot and the rows of its matrix products.
     const auto sum3 = [](V x, V y, V z) { return hn::Add(hn::Add(x, y), z); };
     for (int i = 0; i < n; i += int(hn::Lanes(d))) {
-        const V m = hn::Load(d, L.m + i);
+        // Lanes past n read 0 (never the staging arrays' stale values: no subnormal operands, no
+        // uninitialised reads); their results, infinities and NaNs, are not read back.
+        const auto live = hn::FirstN(d, size_t(n - i));
+        const auto load = [&](const float* p) { return hn::MaskedLoad(live, d, p + i); };
+        const V m = load(L.m);
         const V im = hn::Div(one, m);
         // μ = first·(1/m), about the cell's centre; v = origin + A·(cell + μ).
-        const V mx = hn::Mul(hn::Load(d, L.fx + i), im), my = hn::Mul(hn::Load(d, L.fy + i), im),
-                mz = hn::Mul(hn::Load(d, L.fz + i), im);
-        const V qx = hn::Add(hn::Load(d, L.px + i), mx), qy = hn::Add(hn::Load(d, L.py + i), my),
-                qz = hn::Add(hn::Load(d, L.pz + i), mz);
+        const V mx = hn::Mul(load(L.fx), im), my = hn::Mul(load(L.fy), im),
+                mz = hn::Mul(load(L.fz), im);
+        const V qx = hn::Add(load(L.px), mx), qy = hn::Add(load(L.py), my),
+                qz = hn::Add(load(L.pz), mz);
         // A·q (mat3 · vec3): row r is A[0][r]·q.x + A[1][r]·q.y + A[2][r]·q.z.
         const auto times = [&](V x, V y, V z, int r) {
             return sum3(hn::Mul(a[0][r], x), hn::Mul(a[1][r], y), hn::Mul(a[2][r], z));
@@ -43,12 +47,12 @@ void CellRecordsImpl(const CellFrame& frame, CellLanes& L, int n) {
         const V vx = hn::Add(ox, times(qx, qy, qz, 0)), vy = hn::Add(oy, times(qx, qy, qz, 1)),
                 vz = hn::Add(oz, times(qx, qy, qz, 2));
         // Covariance about μ (index units²).
-        const V cxx = hn::Sub(hn::Mul(hn::Load(d, L.xx + i), im), hn::Mul(mx, mx));
-        const V cyy = hn::Sub(hn::Mul(hn::Load(d, L.yy + i), im), hn::Mul(my, my));
-        const V czz = hn::Sub(hn::Mul(hn::Load(d, L.zz + i), im), hn::Mul(mz, mz));
-        const V cxy = hn::Sub(hn::Mul(hn::Load(d, L.xy + i), im), hn::Mul(mx, my));
-        const V cxz = hn::Sub(hn::Mul(hn::Load(d, L.xz + i), im), hn::Mul(mx, mz));
-        const V cyz = hn::Sub(hn::Mul(hn::Load(d, L.yz + i), im), hn::Mul(my, mz));
+        const V cxx = hn::Sub(hn::Mul(load(L.xx), im), hn::Mul(mx, mx));
+        const V cyy = hn::Sub(hn::Mul(load(L.yy), im), hn::Mul(my, my));
+        const V czz = hn::Sub(hn::Mul(load(L.zz), im), hn::Mul(mz, mz));
+        const V cxy = hn::Sub(hn::Mul(load(L.xy), im), hn::Mul(mx, my));
+        const V cxz = hn::Sub(hn::Mul(load(L.xz), im), hn::Mul(mx, mz));
+        const V cyz = hn::Sub(hn::Mul(load(L.yz), im), hn::Mul(my, mz));
         // uᵀ Σ u with Σ·u (mat3 · vec3, Σ symmetric) then the dot.
         const auto quadratic = [&](V ux, V uy, V uz) {
             const V sx = sum3(hn::Mul(cxx, ux), hn::Mul(cxy, uy), hn::Mul(cxz, uz));
@@ -72,9 +76,9 @@ void CellRecordsImpl(const CellFrame& frame, CellLanes& L, int n) {
         const V full = hn::Mul(fullHalf, hn::Add(ux2, uy2));
         hn::Store(vx, d, L.vx + i), hn::Store(vy, d, L.vy + i), hn::Store(vz, d, L.vz + i);
         hn::Store(distance, d, L.distance + i);
-        hn::Store(hn::Mul(hn::Load(d, L.er + i), im), d, L.r + i);
-        hn::Store(hn::Mul(hn::Load(d, L.eg + i), im), d, L.g + i);
-        hn::Store(hn::Mul(hn::Load(d, L.eb + i), im), d, L.b + i);
+        hn::Store(hn::Mul(load(L.er), im), d, L.r + i);
+        hn::Store(hn::Mul(load(L.eg), im), d, L.g + i);
+        hn::Store(hn::Mul(load(L.eb), im), d, L.b + i);
         hn::Store(hn::Max(hn::Sub(spread, full), zero), d, L.spread + i);
         if (frame.depthSpread) {
             const V wx = hn::Div(vx, distance), wy = hn::Div(vy, distance), wz = hn::Div(vz, distance);
