@@ -11,7 +11,6 @@
 #include <cmath>
 #include <optional>
 #include <type_traits>
-#include <utility>
 
 #include "footprint/ellipsoid.h"
 #include "footprint/kernel.h"
@@ -21,6 +20,7 @@
 #include "volume/leaf_extract.h"
 #include "volume/leaf_moments.h"
 #include "util/error.h"
+#include "util/radix_sort.h"
 #include "util/fnv1a.h"
 #include "volume/emission.h"
 
@@ -29,22 +29,6 @@ namespace vdbsplat {
 namespace {
 constexpr int kBlockDim = 8;  // OpenVDB leaf side; active tiles are split into blocks of this side
 constexpr size_t kMaxWindowBlocks = 512;  // a window grows past its slabs up to this many blocks (recordsOf)
-/// Sorts @p keys ascending: least significant digit first, 11 bits a pass, passes over digits
-/// that every key shares skipped (the ids' high bits, and most of the distances' exponents).
-void radixSort(std::vector<uint64_t>& keys) {
-    constexpr int kBits = 11;
-    constexpr uint64_t kMask = (uint64_t(1) << kBits) - 1;
-    std::vector<uint64_t> other(keys.size());
-    for (int shift = 0; shift < 64; shift += kBits) {
-        std::array<uint32_t, size_t(1) << kBits> count{};
-        for (uint64_t k : keys) ++count[(k >> shift) & kMask];
-        if (keys.empty() || count[(keys[0] >> shift) & kMask] == keys.size()) continue;  // one digit: in order
-        uint32_t sum = 0;
-        for (uint32_t& c : count) c = std::exchange(sum, sum + c);
-        for (uint64_t k : keys) other[count[(k >> shift) & kMask]++] = k;
-        keys.swap(other);
-    }
-}
 constexpr size_t kExtractChunk = 16;      // blocks extracted into one buffer, in order (VoxelStream::next)
 constexpr uint64_t kMaxActiveVoxels = uint64_t(1) << 32;
 }  // namespace
@@ -154,8 +138,8 @@ void VoxelStream::collectBlocks() {
         }
     });
     // Front to back by nearest distance, ties in the grid's order (the blocks' ids): one total
-    // order, whatever the thread count. A radix sort of 64-bit keys (dMin's bits, ≥ 0 so ordered
-    // as integers, then the id): the comparison sort of the blocks, its branches unpredictable,
+    // order, whatever the thread count. A radix sort (util/radix_sort.h) of 64-bit keys (dMin's
+    // bits, ≥ 0 so ordered as integers, then the id): the comparison sort of the blocks, its branches unpredictable,
     // took 0.3–0.5 ms of the far Engine's 5 (4 448 blocks).
     std::vector<uint64_t> keys;
     keys.reserve(all.size());
@@ -163,9 +147,10 @@ void VoxelStream::collectBlocks() {
         if (inside[i]) keys.push_back(uint64_t(std::bit_cast<uint32_t>(all[i].dMin)) << 32 | all[i].id);
         else counts_.frustum += all[i].voxels;
     }
-    radixSort(keys);
+    std::vector<uint64_t> scratch(keys.size());
+    const uint64_t* sorted = radixSortBits(keys.data(), scratch.data(), keys.size(), 0, 64);
     blocks_.resize(keys.size());
-    for (size_t i = 0; i < keys.size(); ++i) blocks_[i] = all[uint32_t(keys[i])];
+    for (size_t i = 0; i < keys.size(); ++i) blocks_[i] = all[uint32_t(sorted[i])];
 }
 
 bool VoxelStream::visible(const Block& b) const {
@@ -638,7 +623,7 @@ void VoxelStream::emitCells(const Block& b, int level, PackedCells acc, const fl
         for (int l = 0; l < staged; ++l, ++k) {
             out.viewPos[k] = glm::vec3(lanes.vx[l], lanes.vy[l], lanes.vz[l]);
             out.distance[k] = lanes.distance[l];
-            out.sigma[k] = weightOf[l] == 1.f ? lanes.m[l] : lanes.m[l] * weightOf[l];
+            out.sigma[k] = lanes.m[l] * weightOf[l];  // × 1 where not blended: exact
             out.color[k] = glm::vec3(lanes.r[l], lanes.g[l], lanes.b[l]);
             out.spread[k] = lanes.spread[l];
             if (options_.depthSpread) out.depthSpread[k] = lanes.depthSpread[l];
