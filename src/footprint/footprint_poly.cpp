@@ -67,6 +67,7 @@ FootprintPolynomials FootprintPolynomials::build(const KernelShape& kernel) {
     FootprintPolynomials p;
     const double s = std::sin(kAlphaMaxDeg * std::numbers::pi / 180.0);
     p.sin2Max_ = s * s;
+    p.rowsPerSin2_ = kRows / p.sin2Max_;
     p.rows_.reserve(kRows + 1);
     for (int r = 0; r <= kRows; ++r) p.rows_.push_back(fitRow(p.sin2Max_ * r / kRows, kernel));
     // The largest value any row takes (a splat's row is a convex combination of two): F falls with

@@ -41,7 +41,9 @@ public:
     bool covers(double sin2Alpha) const { return sin2Alpha >= 0.0 && sin2Alpha <= sin2Max_; }
     /// @brief The coefficients for sin²α = @p sin2Alpha (must be covered): rows interpolated linearly.
     Coefficients row(double sin2Alpha) const {  // inline: the splat loop's caller keeps it in registers
-        const double pos = std::clamp(sin2Alpha / sin2Max_, 0.0, 1.0) * kRows;
+        // × the stored kRows / sin²α_max, not ÷ sin²α_max: a division's latency began every splat's
+        // draw (the product can differ from the quotient in its last bit, a weight's in 2^−29).
+        const double pos = std::clamp(sin2Alpha * rowsPerSin2_, 0.0, double(kRows));
         const int k = std::min(int(pos), kRows - 1);
         const float w = float(pos - k);
         const Coefficients &a = rows_[size_t(k)], &b = rows_[size_t(k) + 1];
@@ -65,6 +67,7 @@ public:
 private:
     std::vector<Coefficients> rows_;  // kRows + 1
     double sin2Max_ = 0.0;
+    double rowsPerSin2_ = 0.0;  ///< kRows / sin2Max_
     float peak_ = 0.f;
 };
 
