@@ -103,6 +103,18 @@ public:
         return true;
     }
 
+    /// @brief True when some pixel of the inclusive rectangle (clamped to the image) is finished
+    /// (T < ε) or the rectangle reaches past the image: tile by tile, by their live counts (a tile
+    /// at the image's edge counts as partly finished). Cheap; asks whether a finer hidden() test of
+    /// parts of the rectangle can pay.
+    bool partlyHidden(int x0, int y0, int x1, int y1) const {
+        if (x0 < 0 || y0 < 0 || x1 >= width_ || y1 >= height_) return true;
+        for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)
+            for (int tx = x0 / kTileSize; tx <= x1 / kTileSize; ++tx)
+                if (liveCount_[size_t(ty) * tilesX_ + tx] < kTileSize * kTileSize) return true;
+        return false;
+    }
+
     /// @brief Composites every slab still open (--compositing slabs: the last windows' slabs wait
     /// for the next window's primitives, whose kernels may reach back into them). Call it after
     /// the last window; nothing to do in the kernel order.

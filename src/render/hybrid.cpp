@@ -97,6 +97,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     std::optional<MarginalCdfTable> marginal;
     if (slabs.on) ctx.marginal = &marginal.emplace(*tables.kernel);
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
+    const auto partlyHidden = [&](int x0, int y0, int x1, int y1) { return compositor.partlyHidden(x0, y0, x1, y1); };
     VoxelBatch& batch = buffers.batch;
     ProjectedWindow& window = buffers.window;
     uint64_t drawnVoxels = 0;
@@ -104,7 +105,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
         if (control.stop && control.stop()) throw RenderStopped("render stopped");
         if (control.progress) control.progress(stream.progress());
         auto t = Clock::now();
-        if (!stream.next(batch, hidden)) break;
+        if (!stream.next(batch, hidden, partlyHidden)) break;
         stats.streamSeconds += since(t);
         t = Clock::now();
         const ProjectionCounts counts = projectBatch(batch, ctx, window);

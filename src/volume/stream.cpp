@@ -169,11 +169,15 @@ bool VoxelStream::visible(const Block& b) const {
 }
 
 void VoxelStream::screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const {
-    // Project the corners of the block's box widened by the kernel radius; the margin
-    // covers the prefilter. Any corner at or behind the eye plane: the whole screen.
+    screenRect(b.origin, b.dim, x0, y0, x1, y1);
+}
+
+void VoxelStream::screenRect(const openvdb::Coord& origin, int dim, int& x0, int& y0, int& x1, int& y1) const {
+    // Project the corners of the box of voxels [origin, origin + dim)³ widened by the kernel radius;
+    // the margin covers the prefilter. Any corner at or behind the eye plane: the whole screen.
     // The map is affine: one corner through it, then the box's three edges as offsets.
-    const double r = Kernel::kRadius + 0.5, side = double(b.dim - 1) + 2.0 * r;
-    const glm::dvec3 low(indexToView_ * glm::dvec4(b.origin.x() - r, b.origin.y() - r, b.origin.z() - r, 1.0));
+    const double r = Kernel::kRadius + 0.5, side = double(dim - 1) + 2.0 * r;
+    const glm::dvec3 low(indexToView_ * glm::dvec4(origin.x() - r, origin.y() - r, origin.z() - r, 1.0));
     const glm::dmat3 edges = glm::dmat3(indexToView_) * side;
     double lox = 1e300, loy = 1e300, hix = -1e300, hiy = -1e300;
     for (int corner = 0; corner < 8; ++corner) {
@@ -194,6 +198,41 @@ void VoxelStream::screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1)
     x1 = int(std::clamp(std::ceil(hix + m), 0.0, double(camera_.width() - 1)));
     y0 = int(std::clamp(std::floor(loy - m), 0.0, double(camera_.height() - 1)));
     y1 = int(std::clamp(std::ceil(hiy + m), 0.0, double(camera_.height() - 1)));
+}
+
+bool VoxelStream::extractsLeafInVectors(const Block& b) const {
+    return b.leaf && !shader_ && !emission_ && options_.vectorExtract && table_.entries() && leafExtractSupported();
+}
+
+// The 4³ octant (i, j, k) of a leaf holds the voxels x ∈ [4i, 4i + 4), y ∈ [4j, 4j + 4),
+// z ∈ [4k, 4k + 4): in mask word x (bit y·8 + z), these bits.
+namespace {
+constexpr uint64_t octantBits(int j, int k) {
+    uint64_t bits = 0;
+    for (int y = 4 * j; y < 4 * j + 4; ++y) bits |= uint64_t(0xf) << (4 * k) << (8 * y);
+    return bits;
+}
+}  // namespace
+
+bool VoxelStream::visibleOctants(const Block& b, const std::function<bool(int, int, int, int)>& hidden,
+                                 std::array<uint64_t, 8>& visible, uint64_t& occluded) const {
+    visible.fill(0);
+    bool any = false;
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+            for (int k = 0; k < 2; ++k) {
+                int x0, y0, x1, y1;
+                screenRect(b.origin.offsetBy(4 * i, 4 * j, 4 * k), 4, x0, y0, x1, y1);
+                if (hidden(x0, y0, x1, y1)) {
+                    any = true;
+                    continue;
+                }
+                for (int x = 4 * i; x < 4 * i + 4; ++x) visible[size_t(x)] |= octantBits(j, k);
+            }
+    if (!any) return false;
+    for (int x = 0; x < 8; ++x)
+        occluded += uint64_t(std::popcount(b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x)) & ~visible[size_t(x)]));
+    return true;
 }
 
 void VoxelStream::lodLevel(Block& b) const {
@@ -338,8 +377,8 @@ struct MomentScratch {
 // camera continuously, so nothing pops; and only the cells inside their stretch are drawn twice.
 // The level with the larger weight carries the voxel counts (members), the other 0: each voxel
 // is counted once.
-void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const {
-    if (b.lodLevel == 0) return extractVoxels(b, nullptr, out);
+void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts, const uint64_t* visible) const {
+    if (b.lodLevel == 0) return extractVoxels(b, nullptr, out, visible);
     MomentScratch scratch;  // not zeroed: cellMoments fills what it hands back
     if (!(b.lodFine > 0.f)) return emitCells(b, b.lodLevel, cellMoments(b, b.lodLevel, scratch.cells), nullptr, false, out, counts);
     const int k = b.lodLevel, parents = kBlockDim >> k;
@@ -394,7 +433,7 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts)
 
 // coarse: per level-1 cell (x>>1, y>>1, z>>1) its weight w_c at level 1; the voxels take 1 − w_c
 // (none drawn, nor classified, where w_c = 1) and carry the counts where w_c < ½. nullptr: w_c = 0.
-void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const {
+void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch& out, const uint64_t* visible) const {
     const glm::dvec3 origin(b.origin.x(), b.origin.y(), b.origin.z());
     const auto wc = [&](int x, int y, int z) { return coarse ? coarse[size_t(((x >> 1) * 4 + (y >> 1)) * 4 + (z >> 1))] : 0.f; };
     // Sized for the block's active voxels first (forEachActive visits exactly b.voxels: the
@@ -408,10 +447,11 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
     size_t k = first;
     // A plain leaf (no shading, emission or blend weights): a vector of rows at a time
     // (volume/leaf_extract.h), the same records as the voxel-by-voxel path below.
-    if (!coarse && b.leaf && !shader_ && !emission_ && options_.vectorExtract && table_.entries() && leafExtractSupported()) {
-        const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE;
+    if (!coarse && extractsLeafInVectors(b)) {
+        const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE && !visible;
         std::array<uint64_t, 8> words;
-        for (int x = 0; x < 8; ++x) words[size_t(x)] = b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));
+        for (int x = 0; x < 8; ++x)
+            words[size_t(x)] = b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x)) & (visible ? visible[x] : ~uint64_t(0));
         const LeafRecords to{out.viewPos.data() + first, out.distance.data() + first, out.sigma.data() + first,
                              out.color.data() + first};
         k += extractLeafVoxels(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, indexToView_,
@@ -704,6 +744,16 @@ struct RecordArrays {
         if (depthSpread) depthSpread[k] = src.depthSpread[i];
         members[k] = src.members[i];
     }
+    /// Records [@p i, @p i + @p n) of @p src copied to [@p k, @p k + @p n) here, array by array.
+    void copyRange(const RecordArrays<const VoxelBatch>& src, size_t i, size_t k, size_t n) const {
+        std::copy_n(src.viewPos + i, n, viewPos + k);
+        std::copy_n(src.distance + i, n, distance + k);
+        std::copy_n(src.sigma + i, n, sigma + k);
+        std::copy_n(src.color + i, n, color + k);
+        std::copy_n(src.spread + i, n, spread + k);
+        if (depthSpread) std::copy_n(src.depthSpread + i, n, depthSpread + k);
+        std::copy_n(src.members + i, n, members + k);
+    }
 };
 }  // namespace
 
@@ -741,6 +791,16 @@ void VoxelStream::release(size_t blocks, float limit, VoxelBatch& batch) {
         for (size_t s = r.begin(); s < r.end(); ++s) {
             size_t begin, end, out = released[s], stay = kept[s];
             const RecordArrays<const VoxelBatch> src(source(s, begin, end));
+            // A source wholly on one side of the limit (most blocks: a window's depth range is
+            // many blocks deep) is copied array by array: the same records in the same places.
+            if (released[s + 1] - out == end - begin) {
+                toBatch.copyRange(src, begin, out, end - begin);
+                continue;
+            }
+            if (kept[s + 1] - stay == end - begin) {
+                toPending.copyRange(src, begin, stay, end - begin);
+                continue;
+            }
             for (size_t i = begin; i < end; ++i)
                 src.distance[i] < limit ? toBatch.copy(src, i, out++) : toPending.copy(src, i, stay++);
         }
@@ -748,7 +808,8 @@ void VoxelStream::release(size_t blocks, float limit, VoxelBatch& batch) {
     std::swap(pending_, pendingNext_);
 }
 
-bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden) {
+bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden,
+                       const std::function<bool(int, int, int, int)>& partlyHidden) {
     batch.clear();
     // Room for the largest windows at once: grown window by window, the batch and the pending
     // records were copied at every growth and took fresh pages each time (a one-shot render's
@@ -799,13 +860,18 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                         for (int line = 0; line < 32; ++line) __builtin_prefetch(next + 64 * line);
                     }
                     const size_t begin = e.size();
-                    bool hiddenBlock = false;
+                    bool hiddenBlock = false, partly = false;
                     if (hidden) {
                         int x0, y0, x1, y1;
                         screenRect(b, x0, y0, x1, y1);
                         hiddenBlock = hidden(x0, y0, x1, y1);
+                        partly = !hiddenBlock && partlyHidden && options_.octantCulling && b.lodLevel == 0 && extractsLeafInVectors(b) &&
+                                 partlyHidden(x0, y0, x1, y1);
                     }
+                    std::array<uint64_t, 8> visible;
                     if (hiddenBlock) skipped_[j] = 1;
+                    else if (partly && visibleOctants(b, hidden, visible, blockCounts_[j].occluded))
+                        extract(b, e, blockCounts_[j], visible.data());
                     else extract(b, e, blockCounts_[j]);
                     blockRecords_[j] = {begin, e.size()};
                 }
@@ -813,6 +879,7 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
         });
         for (size_t i = first; i < nextBlock_; ++i) {
             if (skipped_[i - first]) counts_.occluded += blocks_[i].voxels;
+            counts_.occluded += blockCounts_[i - first].occluded;
             counts_.aggregates += blockCounts_[i - first].aggregates;
             counts_.aggregatedVoxels += blockCounts_[i - first].aggregatedVoxels;
         }

@@ -20,6 +20,7 @@
 // what an aggregate loses is the ordering of its own voxels in depth (measured in
 // docs/fidelity.md, docs/animation.md).
 #pragma once
+#include <array>
 #include <atomic>
 #include <functional>
 #include <glm/glm.hpp>
@@ -139,6 +140,11 @@ struct StreamOptions {
     /// Plain leaves' voxels through the vectorised extraction (volume/leaf_extract.h); false: the
     /// voxel-by-voxel path it is tested against (the same records, bit for bit).
     bool vectorExtract = true;
+    /// With an occlusion test (next()'s partlyHidden): a leaf drawn voxel by voxel whose screen
+    /// rectangle is partly behind finished pixels is tested octant by octant (4³ voxels), and the
+    /// hidden octants are neither classified nor projected (counted as occluded). False: the whole
+    /// leaf is extracted and its hidden voxels dropped after projection. The same image either way.
+    bool octantCulling = true;
     /// Keep the level-of-detail moments in the buffers (StreamBuffers::moments) for the next render
     /// of the same grid and table: set by renders that pass buffers kept between them (bench,
     /// animate, study). Off for a single render, which would only fill it. Not with shading or
@@ -217,7 +223,11 @@ public:
     /// @brief Fills @p batch with the next window front to back; false when the stream is done.
     /// @param hidden optional: returns true for a block whose screen rectangle (pixels,
     /// x0, y0, x1, y1 inclusive) is entirely behind opaque pixels, so it can be skipped.
-    bool next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden = {});
+    /// @param partlyHidden optional, with @p hidden: true when some pixel of the rectangle is
+    /// behind opaque pixels; a leaf drawn voxel by voxel for which it holds is tested octant by
+    /// octant (4³ voxels each) with @p hidden, and the hidden octants are not extracted.
+    bool next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden = {},
+              const std::function<bool(int, int, int, int)>& partlyHidden = {});
 
     uint64_t culledVoxels() const { return counts_.frustum + counts_.occluded; }  ///< voxels in culled blocks
     const StreamCounts& counts() const { return counts_; }
@@ -242,10 +252,18 @@ private:
     void collectBlocks();
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
+    void screenRect(const openvdb::Coord& origin, int dim, int& x0, int& y0, int& x1, int& y1) const;
+    bool extractsLeafInVectors(const Block& b) const;  // extractVoxels' vector path applies to b
+    /// The octants of leaf @p b not hidden, as value-mask words (@p visible); adds the active
+    /// voxels of the hidden ones to @p occluded. False (nothing set) when no octant is hidden.
+    bool visibleOctants(const Block& b, const std::function<bool(int, int, int, int)>& hidden,
+                        std::array<uint64_t, 8>& visible, uint64_t& occluded) const;
     void lodLevel(Block& b) const;  // sets b.lodLevel and b.lodFine
     static size_t recordsOf(const Block& b);  // about how many records b's extraction gives
-    void extract(const Block& b, VoxelBatch& out, StreamCounts& counts) const;  // counts: aggregates only
-    void extractVoxels(const Block& b, const float* coarse, VoxelBatch& out) const;
+    /// counts: aggregates only. @p visible: the leaf's voxels to extract, as value-mask words
+    /// (a level-0 block of extractsLeafInVectors only); null: all.
+    void extract(const Block& b, VoxelBatch& out, StreamCounts& counts, const uint64_t* visible = nullptr) const;
+    void extractVoxels(const Block& b, const float* coarse, VoxelBatch& out, const uint64_t* visible = nullptr) const;
     /// The moments of @p b's cells at @p level: its kept slots (packed), or @p scratch (room for 64
     /// cells) filled and marked in place.
     PackedCells cellMoments(const Block& b, int level, CellMoments* scratch) const;

@@ -686,5 +686,50 @@ void expectLeafExtractionMatchesTheVoxels() {
     EXPECT_GT(kept, 3000u);
 }
 
+// Octant culling (StreamOptions::octantCulling): with the left half of the image finished, a leaf
+// whose rectangle straddles the edge keeps only its octants that reach the right half. The
+// records are those of the stream without it, in order, less some whose voxels lie left of the
+// edge; each voxel left out is counted as occluded, and some are left out.
+TEST(Stream, HiddenOctantsAreNeitherExtractedNorReleased) {
+    const Volume& v = cloud();
+    const Camera camera = framedCamera(v, 256, 1.0);
+    const ClassificationTable table = constantTable(0.05f);  // every active voxel gives a record
+    const int edge = 128;
+    const auto hidden = [&](int, int, int x1, int) { return x1 < edge; };
+    const auto partlyHidden = [&](int x0, int, int, int) { return x0 < edge; };
+    struct Run {
+        std::vector<std::array<float, 4>> records;  // view position, σ
+        uint64_t occluded = 0;
+    };
+    std::vector<Run> runs;
+    for (const bool octants : {false, true}) {
+        StreamOptions o;
+        o.octantCulling = octants;
+        VoxelStream stream(v, camera, table, o);
+        VoxelBatch batch;
+        Run run;
+        while (stream.next(batch, hidden, partlyHidden))
+            for (size_t i = 0; i < batch.size(); ++i)
+                run.records.push_back({batch.viewPos[i].x, batch.viewPos[i].y, batch.viewPos[i].z, batch.sigma[i]});
+        run.occluded = stream.counts().occluded;
+        runs.push_back(std::move(run));
+    }
+    const Run &all = runs[0], &culled = runs[1];
+    size_t j = 0, left = 0;
+    for (const auto& r : all.records) {
+        if (j < culled.records.size() && culled.records[j] == r) {
+            ++j;
+            continue;
+        }
+        ++left;
+        const PixelCoord p = camera.project(ViewPoint(glm::dvec3(r[0], r[1], r[2])));
+        ASSERT_LT(p.x, double(edge)) << "a voxel right of the edge was culled";
+    }
+    EXPECT_EQ(j, culled.records.size()) << "the culled stream's records are not the others', in order";
+    EXPECT_GT(left, 1000u);
+    EXPECT_LT(left, all.records.size() / 2);
+    EXPECT_EQ(culled.occluded - all.occluded, left);
+}
+
 }  // namespace
 }  // namespace vdbsplat
