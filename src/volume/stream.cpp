@@ -855,6 +855,13 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                 for (size_t j = c * kExtractChunk; j < chunkEnd; ++j) {
                     const size_t i = first + j;
                     const Block& b = blocks_[i];
+                    // The leaf node two blocks ahead (its buffer's pointer and value mask: a miss
+                    // each that the next block's buffer prefetch below waited on), then the next
+                    // block's values.
+                    if (j + 2 < chunkEnd && blocks_[i + 2].leaf) {
+                        const char* node = reinterpret_cast<const char*>(blocks_[i + 2].leaf);
+                        __builtin_prefetch(node), __builtin_prefetch(node + sizeof(*blocks_[i + 2].leaf) - 1);
+                    }
                     if (j + 1 < chunkEnd && blocks_[i + 1].leaf && !momentsKept(blocks_[i + 1])) {
                         const char* next = reinterpret_cast<const char*>(blocks_[i + 1].leaf->buffer().data());
                         for (int line = 0; line < 32; ++line) __builtin_prefetch(next + 64 * line);
