@@ -335,6 +335,16 @@ struct TileCompositor::TilePixels {
     }
 };
 
+bool TileCompositor::hiddenTiles(int x0, int y0, int x1, int y1) const {
+    x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, width_ - 1), y1 = std::min(y1, height_ - 1);
+    if (x0 > x1 || y0 > y1) return true;
+    if (liveRows_[size_t(y0) * size_t(tilesX_) + size_t(x0 / kTileSize)] >> (x0 % kTileSize) & 1u) return false;
+    for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)
+        for (int tx = x0 / kTileSize; tx <= x1 / kTileSize; ++tx)
+            if (liveCount_[size_t(ty) * tilesX_ + tx] > 0 && anyLive(tx, ty, x0, y0, x1, y1)) return false;
+    return true;
+}
+
 void TileCompositor::loadTile(int tile, TilePixels& px) const {
     px.x0 = (tile % tilesX_) * kTileSize, px.y0 = (tile / tilesX_) * kTileSize;
     px.x1 = std::min(width_, px.x0 + kTileSize) - 1, px.y1 = std::min(height_, px.y0 + kTileSize) - 1;
