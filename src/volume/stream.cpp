@@ -103,7 +103,8 @@ void VoxelStream::collectBlocks() {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) onVoxels[i] = uint32_t(leaves[i]->onVoxelCount());
     });
-    std::vector<Block> all;
+    std::vector<Block>& all = blocks_;  // in the grid's order: a block's id is its place here
+    all.clear();
     all.reserve(leaves.size());
     for (size_t i = 0; i < leaves.size(); ++i)
         if (onVoxels[i] != 0)
@@ -149,8 +150,10 @@ void VoxelStream::collectBlocks() {
     }
     std::vector<uint64_t> scratch(keys.size());
     const uint64_t* sorted = radixSortBits(keys.data(), scratch.data(), keys.size(), 0, 64);
-    blocks_.resize(keys.size());
-    for (size_t i = 0; i < keys.size(); ++i) blocks_[i] = all[uint32_t(sorted[i])];
+    // The order as indices: the blocks stay where they are (a sorted copy of them was a fresh
+    // 48 bytes a block, 52 page faults for the Engine's 4 448, 0.15 ms of a far render's 5).
+    order_.resize(keys.size());
+    for (size_t i = 0; i < keys.size(); ++i) order_[i] = uint32_t(sorted[i]);
 }
 
 bool VoxelStream::visible(const Block& b) const {
@@ -816,26 +819,26 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
     // most page faults). Reserved, nothing is touched until written; by the records the blocks
     // give, not their voxels (room for a far view's voxels is huge pages it would touch for few).
     if (records_ == 0)
-        for (const Block& b : blocks_) records_ += recordsOf(b);
+        for (const uint32_t k : order_) records_ += recordsOf(blocks_[k]);
     const size_t room = std::min<size_t>(records_, 2 * options_.maxWindowVoxels);
     if (batch.viewPos.capacity() < room) batch.reserve(room, options_.depthSpread);
     if (pending_.viewPos.capacity() < room) pending_.reserve(room, options_.depthSpread), pendingNext_.reserve(room, options_.depthSpread);
     while (true) {
         if (pending_.size() == 0) {
-            if (nextBlock_ >= blocks_.size()) return false;
+            if (nextBlock_ >= order_.size()) return false;
             // Skip empty depth: jump to the next block's front.
-            nextSlab_ = std::max<int64_t>(nextSlab_, int64_t(std::floor(blocks_[nextBlock_].dMin / slabLength_)));
+            nextSlab_ = std::max<int64_t>(nextSlab_, int64_t(std::floor(block(nextBlock_).dMin / slabLength_)));
         }
         // The window: at least slabsPerWindow slabs, grown while it would hold too few voxels.
         int64_t slabEnd = nextSlab_ + slabsPerWindow_;
         size_t first = nextBlock_;
         size_t estimate = pending_.size();
-        while (nextBlock_ < blocks_.size() && blocks_[nextBlock_].dMin < slabEnd * slabLength_) {
-            estimate += recordsOf(blocks_[nextBlock_]);
+        while (nextBlock_ < order_.size() && block(nextBlock_).dMin < slabEnd * slabLength_) {
+            estimate += recordsOf(block(nextBlock_));
             ++nextBlock_;
-            if (nextBlock_ < blocks_.size() && estimate < options_.minWindowVoxels && nextBlock_ - first < kMaxWindowBlocks &&
-                blocks_[nextBlock_].dMin >= slabEnd * slabLength_)
-                slabEnd = int64_t(std::floor(blocks_[nextBlock_].dMin / slabLength_)) + slabsPerWindow_;
+            if (nextBlock_ < order_.size() && estimate < options_.minWindowVoxels && nextBlock_ - first < kMaxWindowBlocks &&
+                block(nextBlock_).dMin >= slabEnd * slabLength_)
+                slabEnd = int64_t(std::floor(block(nextBlock_).dMin / slabLength_)) + slabsPerWindow_;
         }
         // Activate the blocks whose front the window reached: extract them in parallel, in order.
         // The chunks' buffers are reused window after window (no allocation once warm).
@@ -854,16 +857,16 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                 const size_t chunkEnd = std::min(count, (c + 1) * kExtractChunk);
                 for (size_t j = c * kExtractChunk; j < chunkEnd; ++j) {
                     const size_t i = first + j;
-                    const Block& b = blocks_[i];
+                    const Block& b = block(i);
                     // The leaf node two blocks ahead (its buffer's pointer and value mask: a miss
                     // each that the next block's buffer prefetch below waited on), then the next
                     // block's values.
-                    if (j + 2 < chunkEnd && blocks_[i + 2].leaf) {
-                        const char* node = reinterpret_cast<const char*>(blocks_[i + 2].leaf);
-                        __builtin_prefetch(node), __builtin_prefetch(node + sizeof(*blocks_[i + 2].leaf) - 1);
+                    if (j + 2 < chunkEnd && block(i + 2).leaf) {
+                        const char* node = reinterpret_cast<const char*>(block(i + 2).leaf);
+                        __builtin_prefetch(node), __builtin_prefetch(node + sizeof(*block(i + 2).leaf) - 1);
                     }
-                    if (j + 1 < chunkEnd && blocks_[i + 1].leaf && !momentsKept(blocks_[i + 1])) {
-                        const char* next = reinterpret_cast<const char*>(blocks_[i + 1].leaf->buffer().data());
+                    if (j + 1 < chunkEnd && block(i + 1).leaf && !momentsKept(block(i + 1))) {
+                        const char* next = reinterpret_cast<const char*>(block(i + 1).leaf->buffer().data());
                         for (int line = 0; line < 32; ++line) __builtin_prefetch(next + 64 * line);
                     }
                     const size_t begin = e.size();
@@ -885,7 +888,7 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
             }
         });
         for (size_t i = first; i < nextBlock_; ++i) {
-            if (skipped_[i - first]) counts_.occluded += blocks_[i].voxels;
+            if (skipped_[i - first]) counts_.occluded += block(i).voxels;
             counts_.occluded += blockCounts_[i - first].occluded;
             counts_.aggregates += blockCounts_[i - first].aggregates;
             counts_.aggregatedVoxels += blockCounts_[i - first].aggregatedVoxels;

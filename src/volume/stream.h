@@ -235,7 +235,7 @@ public:
     size_t largestWindow() const { return largest_; }    ///< most voxels in one window so far
     double slabLength() const { return slabLength_; }    ///< world length of one slab
     /// Fraction of the visible blocks streamed so far (for progress reports).
-    double progress() const { return blocks_.empty() ? 1.0 : double(nextBlock_) / double(blocks_.size()); }
+    double progress() const { return order_.empty() ? 1.0 : double(nextBlock_) / double(order_.size()); }
 
 private:
     struct Block {
@@ -284,7 +284,9 @@ private:
     const VoxelShader* shader_;
     const EmissionSource* emission_;
     double slabLength_;
-    std::vector<Block> blocks_;   // sorted by dMin
+    std::vector<Block> blocks_;     // every block, in the grid's order (Block::id is its index)
+    std::vector<uint32_t> order_;   // the blocks in the frustum, front to back (dMin, then id)
+    const Block& block(size_t k) const { return blocks_[order_[k]]; }  // the k-th in order_
     size_t nextBlock_ = 0;
     std::unique_ptr<StreamBuffers> own_;  // the buffers, unless the caller keeps them
     VoxelBatch& pending_;         // voxels of activated blocks not yet released
