@@ -14,6 +14,7 @@
 #include "footprint/kernel.h"
 #include "footprint/pixel_box.h"
 #include "render/forward_buffers.h"
+#include "render/pending_tables.h"
 #include "render/postfilter.h"
 #include "render/project.h"
 #include "volume/stream.h"
@@ -47,7 +48,7 @@ struct ForwardPass {
 using FrameSink = std::function<Image(const FrameView&)>;
 
 /// Streams, projects and composites @p volume onto @p camera's pixels; returns @p sink's image of the frame.
-Image composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, const Tables& tables,
+Image composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, PendingTables& pending,
                 const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
                 const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission, const FrameSink& sink) {
     // The kernels' shape in view space (anisotropic or sheared voxels: ellipsoids).
@@ -63,7 +64,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     // kernel spans at most 2·kMaxSlabReach slabs (R·sMax ≤ K·slab): voxels 1×1×2.5 get 0.92.
     if (slabOrder && settings.slabThickness == 0.0)
         streamOptions.slabThickness = std::max(streamOptions.slabThickness,
-                                               tables.kernel->radius() * shape.sMax / (kMaxSlabReach * volume.voxelSize));
+                                               pending.kernel().radius() * shape.sMax / (kMaxSlabReach * volume.voxelSize));
     // Windows of the same depth whatever the slab: 8 voxels' worth of slabs (the window's voxel
     // bounds still narrow it; windows split only at slab boundaries, so the image is the same).
     streamOptions.slabsPerWindow = int(std::lround(streamOptions.slabsPerWindow / streamOptions.slabThickness));
@@ -84,8 +85,9 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     SlabCompositing slabs;
     if (slabOrder) {
         slabs.on = true;
-        slabs.reach = slabReachFor(tables.kernel->radius() * shape.sMax / stream.slabLength());
+        slabs.reach = slabReachFor(pending.kernel().radius() * shape.sMax / stream.slabLength());
     }
+    const Tables& tables = pending.get();  // read meanwhile (render/pending_tables.h)
     TileCompositor compositor(camera.width(), camera.height(), tables, exact, slabs, &buffers.compositor);
     ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
                           settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
@@ -198,7 +200,7 @@ Image placed(const FrameView& frame, int x0, int y0, int width, int height) {
 }  // namespace
 
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
-                    const Tables& tables, const RenderSettings& settings, RenderStats& stats,
+                    PendingTables& tables, const RenderSettings& settings, RenderStats& stats,
                     const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
     // Fixed costs follow the pixels the volume covers, not the image: the compositor, its
     // tiles and the postfilter see only that rectangle (a cropped camera: the same rays, so the
@@ -209,7 +211,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
         const bool none = settings.mode == RenderMode::None;
         const double v = none ? 0.0 : kPrefilterVariance;
         const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, v, v};
-        const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, *tables.kernel), 0);
+        const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, tables.kernel()), 0);
         const auto at = [&](int x0, int y0) {
             return [&camera, x0, y0](const FrameView& f) { return placed(f, x0, y0, camera.width(), camera.height()); };
         };
@@ -230,7 +232,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     // pixels they reach through the filter lie within `border` more; the crop of the sub-pixel
     // image is that output rectangle with its own border, as subpixelCamera frames the whole image.
     const std::optional<PixelRange> crop =
-        coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, *tables.kernel), grid.border);
+        coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, tables.kernel()), grid.border);
     // The postfilter reads the compositor's frame and writes the output image's rectangle.
     const auto filtered = [&](int x0, int y0, int w, int h) {
         return [&camera, &grid, x0, y0, w, h](const FrameView& f) {

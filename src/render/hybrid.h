@@ -14,10 +14,13 @@
 
 namespace vdbsplat {
 
+class PendingTables;  // render/pending_tables.h
+
 /// @brief Renders @p volume in settings.mode (Hybrid, Splat or Point).
+/// @p tables: for settings.kernel, waited for where the compositor first needs them.
 /// @p emission: each voxel's emission (nullptr: none; docs/emission.md).
 Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
-                    const Tables& tables, const RenderSettings& settings, RenderStats& stats,
+                    PendingTables& tables, const RenderSettings& settings, RenderStats& stats,
                     const VoxelShader* shader = nullptr, const RenderControl& control = {},
                     const EmissionSource* emission = nullptr);
 

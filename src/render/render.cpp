@@ -6,9 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "footprint/tables.h"
 #include "render/hybrid.h"
+#include "render/pending_tables.h"
 #include "render/reference.h"
 #include "shading/shading_field.h"
 #include "util/error.h"
@@ -93,6 +95,12 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     if (control.stop && control.stop()) throw RenderStopped("render stopped before it began");
     checkVoxelBudget(volume, requested);
     checkKernelShape(volume, requested);
+    // The forward modes' tables are read on a worker while this thread bakes the transfer
+    // function and renderForward sets up the stream (render/pending_tables.h).
+    std::optional<PendingTables> tables;
+    if (requested.mode != RenderMode::Reference)
+        tables.emplace(requested.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(requested.tablesDir),
+                       KernelShape::named(requested.kernel));
     float lo, hi;
     normalizationRange(volume, lo, hi);
     const ClassificationTable table = tf.bake(lo, hi, volume.voxelSize);
@@ -126,10 +134,7 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
         case RenderMode::Ewa:
         case RenderMode::Swan:
         case RenderMode::None: {
-            const Tables tables =
-                loadOrBuildTables(settings.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(settings.tablesDir),
-                                  KernelShape::named(settings.kernel));
-            image = renderForward(volume, table, camera, tables, settings, stats, shader.get(), control, emission.get());
+            image = renderForward(volume, table, camera, *tables, settings, stats, shader.get(), control, emission.get());
             break;
         }
     }
