@@ -224,6 +224,12 @@ TEST(SlabCompositing, OctantCullingKeepsTheImage) {
         RenderSettings s = withOrder(lookingAt(RenderMode::Hybrid, {-40.0, 70.0, -60.0}, {24.0, 20.0, 28.0}, 96), order);
         RenderStats on, off;
         const Image culled = renderWith(box, tf, s, &on);
+        Image oneThread;
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+            oneThread = renderWith(box, tf, s);
+        }
+        EXPECT_TRUE(culled.pixels == oneThread.pixels) << "octant culling made the image depend on the thread count";
         s.stream.octantCulling = false;
         const Image whole = renderWith(box, tf, s, &off);
         ASSERT_EQ(culled.pixels.size(), whole.pixels.size());
