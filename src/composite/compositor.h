@@ -105,14 +105,16 @@ public:
     bool hiddenTiles(int x0, int y0, int x1, int y1) const;
 
     /// @brief True when some pixel of the inclusive rectangle (clamped to the image) is finished
-    /// (T < ε) or the rectangle reaches past the image: tile by tile, by their live counts (a tile
-    /// at the image's edge counts as partly finished). Cheap; asks whether a finer hidden() test of
-    /// parts of the rectangle can pay.
+    /// (T < ε) or the rectangle reaches past the image: tile by tile, a tile's live count against
+    /// its pixels in the image. Cheap; asks whether a finer hidden() test of parts of the rectangle
+    /// can pay.
     bool partlyHidden(int x0, int y0, int x1, int y1) const {
         if (x0 < 0 || y0 < 0 || x1 >= width_ || y1 >= height_) return true;
-        for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty)
+        for (int ty = y0 / kTileSize; ty <= y1 / kTileSize; ++ty) {
+            const int rows = std::min(kTileSize, height_ - ty * kTileSize);
             for (int tx = x0 / kTileSize; tx <= x1 / kTileSize; ++tx)
-                if (liveCount_[size_t(ty) * tilesX_ + tx] < kTileSize * kTileSize) return true;
+                if (liveCount_[size_t(ty) * tilesX_ + tx] < rows * std::min(kTileSize, width_ - tx * kTileSize)) return true;
+        }
         return false;
     }
 

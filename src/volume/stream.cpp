@@ -203,10 +203,6 @@ void VoxelStream::screenRect(const openvdb::Coord& origin, int dim, int& x0, int
     y1 = int(std::clamp(std::ceil(hiy + m), 0.0, double(camera_.height() - 1)));
 }
 
-bool VoxelStream::extractsLeafInVectors(const Block& b) const {
-    return b.leaf && !shader_ && !emission_ && options_.vectorExtract && table_.entries() && leafExtractSupported();
-}
-
 // The 4³ octant (i, j, k) of a leaf holds the voxels x ∈ [4i, 4i + 4), y ∈ [4j, 4j + 4),
 // z ∈ [4k, 4k + 4): in mask word x (bit y·8 + z), these bits.
 namespace {
@@ -450,7 +446,7 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
     size_t k = first;
     // A plain leaf (no shading, emission or blend weights): a vector of rows at a time
     // (volume/leaf_extract.h), the same records as the voxel-by-voxel path below.
-    if (!coarse && extractsLeafInVectors(b)) {
+    if (!coarse && b.leaf && !shader_ && !emission_ && options_.vectorExtract && table_.entries() && leafExtractSupported()) {
         const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE && !visible;
         std::array<uint64_t, 8> words;
         for (int x = 0; x < 8; ++x)
@@ -465,7 +461,8 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
         out.resize(k);
         return;
     }
-    forEachActive(b, [&](int x, int y, int z) { return wc(x, y, z) < 1.f; },
+    const auto shown = [&](int x, int y, int z) { return !visible || (visible[x] >> (y * 8 + z) & 1u); };
+    forEachActive(b, [&](int x, int y, int z) { return wc(x, y, z) < 1.f && shown(x, y, z); },
                   [&](int x, int y, int z, const Classified& cls) {
         if (!(cls.sigma > 0.f)) return;
         const float c = wc(x, y, z), w = 1.f - c;
@@ -875,7 +872,7 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                         int x0, y0, x1, y1;
                         screenRect(b, x0, y0, x1, y1);
                         hiddenBlock = hidden(x0, y0, x1, y1);
-                        partly = !hiddenBlock && partlyHidden && options_.octantCulling && b.lodLevel == 0 && extractsLeafInVectors(b) &&
+                        partly = !hiddenBlock && partlyHidden && options_.octantCulling && b.lodLevel == 0 && b.leaf &&
                                  partlyHidden(x0, y0, x1, y1);
                     }
                     std::array<uint64_t, 8> visible;

@@ -253,7 +253,6 @@ private:
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
     void screenRect(const openvdb::Coord& origin, int dim, int& x0, int& y0, int& x1, int& y1) const;
-    bool extractsLeafInVectors(const Block& b) const;  // extractVoxels' vector path applies to b
     /// The octants of leaf @p b not hidden, as value-mask words (@p visible); adds the active
     /// voxels of the hidden ones to @p occluded. False (nothing set) when no octant is hidden.
     bool visibleOctants(const Block& b, const std::function<bool(int, int, int, int)>& hidden,
@@ -261,7 +260,7 @@ private:
     void lodLevel(Block& b) const;  // sets b.lodLevel and b.lodFine
     static size_t recordsOf(const Block& b);  // about how many records b's extraction gives
     /// counts: aggregates only. @p visible: the leaf's voxels to extract, as value-mask words
-    /// (a level-0 block of extractsLeafInVectors only); null: all.
+    /// (a level-0 leaf block only); null: all.
     void extract(const Block& b, VoxelBatch& out, StreamCounts& counts, const uint64_t* visible = nullptr) const;
     void extractVoxels(const Block& b, const float* coarse, VoxelBatch& out, const uint64_t* visible = nullptr) const;
     /// The moments of @p b's cells at @p level: its kept slots (packed), or @p scratch (room for 64

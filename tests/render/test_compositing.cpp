@@ -216,12 +216,15 @@ TEST(SlabCompositing, OpaqueFrontHidesTheBack) {
 // Octant culling (StreamOptions::octantCulling) changes what is streamed, never the image: a box
 // seen from off every axis, opaque within a few voxels, where the leaves along the edges of what
 // is already opaque are partly hidden. Bit-identical images, kernel and slab order, and more
-// voxels counted occluded (never classified), fewer dropped after projection.
+// voxels counted occluded (never classified), fewer dropped after projection. Shaded, the leaves
+// take the voxel-by-voxel extraction, which honours the octants too.
 TEST(SlabCompositing, OctantCullingKeepsTheImage) {
     const TransferFunction tf = constantTf(1.5f);
     const Volume box = boxVolume({0, 0, 0}, {47, 39, 55});
+    for (const ShadingMode shading : {ShadingMode::Off, ShadingMode::Phong})
     for (const CompositingOrder order : {CompositingOrder::Kernels, CompositingOrder::Slabs}) {
         RenderSettings s = withOrder(lookingAt(RenderMode::Hybrid, {-40.0, 70.0, -60.0}, {24.0, 20.0, 28.0}, 96), order);
+        s.shading.mode = shading;
         RenderStats on, off;
         const Image culled = renderWith(box, tf, s, &on);
         Image oneThread;
