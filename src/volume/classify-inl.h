@@ -39,7 +39,8 @@ struct ClassifyLanes {
     static_assert(sizeof(Classified) == 4 * sizeof(float), "Classified is {vec3 colour, float σ}");
     D d;
     V scale, offset, zero, top, transparent;
-    const double* pairs;  ///< the entries as pairs of floats: (r, g), (b, σ)
+    const double* pairs;        ///< the entries as pairs of floats: (r, g), (b, σ)
+    const LinearPieces* pieces;  ///< the exact pieces, or nullptr: the entries
 
     ClassifyLanes(D tag, const ClassificationTable& table)
         : d(tag),
@@ -48,7 +49,8 @@ struct ClassifyLanes {
           zero(hwy::HWY_NAMESPACE::Zero(tag)),
           top(hwy::HWY_NAMESPACE::Set(tag, float(ClassificationTable::kSize - 1))),
           transparent(hwy::HWY_NAMESPACE::Set(tag, table.transparentBelow())),
-          pairs(reinterpret_cast<const double*>(table.entries())) {}
+          pairs(reinterpret_cast<const double*>(table.entries())),
+          pieces(table.pieces().count ? &table.pieces() : nullptr) {}
 
     /// The lanes' table index x (0 where !active).
     template <class M>
@@ -64,6 +66,7 @@ struct ClassifyLanes {
     /// element loads of one 32-bit gather per channel and entry), and even/odd lanes split them.
     template <class M>
     void operator()(V x, M active, V& sigma, V& r, V& g, V& b) const {
+        if (pieces) return Pieces(x, active, sigma, r, g, b);
         namespace hn = hwy::HWY_NAMESPACE;
         const hn::RebindToSigned<D> di;
         const hn::Repartition<double, D> dd;
@@ -82,6 +85,35 @@ struct ClassifyLanes {
         const auto lerp = [&](V lo, V hi) { return hn::Add(lo, hn::Mul(t, hn::Sub(hi, lo))); };
         sigma = hn::IfThenElseZero(active, lerp(s0, s1));
         r = lerp(r0, r1), g = lerp(g0, g1), b = lerp(b0, b1);
+    }
+
+    /// As operator(), by LinearPieces::operator(): each lane's piece j is its bucket's first
+    /// piece, plus one for each following knot at or below x (knotsPerBucket compares); its knot,
+    /// values and slopes are permuted out of the pieces' columns (one vector of 16, or two of 8
+    /// and a blend); then value + slope · (x − knot).
+    template <class M>
+    void Pieces(V x, M active, V& sigma, V& r, V& g, V& b) const {
+        namespace hn = hwy::HWY_NAMESPACE;
+        const hn::RebindToSigned<D> di;
+        constexpr int kLanes = int(hn::MaxLanes(D()));
+        static_assert(kLanes == LinearPieces::kMax || 2 * kLanes == LinearPieces::kMax, "16 pieces: 1 or 2 vectors");
+        // Lane j's entry of a column of kMax numbers (float or int32).
+        const auto column = [&](auto tag, const auto* c, auto j) {
+            const auto low = hn::IndicesFromVec(tag, hn::And(j, hn::Set(di, kLanes - 1)));
+            const auto lo = hn::TableLookupLanes(hn::Load(tag, c), low);
+            if constexpr (kLanes == LinearPieces::kMax) return lo;
+            else return hn::IfThenElse(hn::RebindMask(tag, hn::Gt(j, hn::Set(di, kLanes - 1))),
+                                       hn::TableLookupLanes(hn::Load(tag, c + kLanes), low), lo);
+        };
+        auto j = column(di, pieces->firstOfBucket, hn::ShiftRight<LinearPieces::kBucketShift>(hn::ConvertTo(di, x)));
+        for (int k = 0; k < pieces->knotsPerBucket; ++k)  // j += (x ≥ next knot): the mask as −1
+            j = hn::Sub(j, hn::VecFromMask(di, hn::RebindMask(di, hn::Ge(x, column(d, pieces->next, j)))));
+        const auto at = [&](const float* c) { return column(d, c, j); };
+        const V dx = hn::Sub(x, at(pieces->knot));
+        const auto channel = [&](int c) { return hn::Add(at(pieces->value[c]), hn::Mul(at(pieces->slope[c]), dx)); };
+        r = channel(0), g = channel(1), b = channel(2);
+        const V s = channel(3);
+        sigma = hn::IfThenElseZero(hn::And(active, hn::Gt(s, zero)), s);
     }
 };
 

@@ -381,8 +381,9 @@ TransferFunction firePreset() {
 
 // --- ClassificationTable -----------------------------------------------------
 
-ClassificationTable::ClassificationTable(std::vector<Classified> entries, float valueMin, float valueMax)
-    : entries_(std::move(entries)) {
+ClassificationTable::ClassificationTable(std::vector<Classified> entries, float valueMin, float valueMax,
+                                         const LinearPieces& pieces)
+    : entries_(std::move(entries)), pieces_(pieces) {
     if (valueMax > valueMin) {
         // Scale/offset in double so valueMin → 0 and valueMax → kSize − 1 as exactly as floats allow.
         const double scale = double(kSize - 1) / (double(valueMax) - double(valueMin));
@@ -395,12 +396,30 @@ ClassificationTable::ClassificationTable(std::vector<Classified> entries, float 
     if (!entries_.empty() && entries_.size() != size_t(kSize))
         throw Error("classification table: expected " + std::to_string(kSize) + " entries, got " +
                     std::to_string(entries_.size()));
+    if (pieces_.count < 0 || pieces_.count > LinearPieces::kMax || pieces_.knot[0] != 0.f)
+        throw Error("classification table: pieces must number 0.." + std::to_string(LinearPieces::kMax) +
+                    " and start at index 0");
+    if (pieces_.count) {
+        static_assert(LinearPieces::kMax * LinearPieces::kBucketWidth == kSize, "the buckets cover the table");
+        pieces_.index();
+        // Below the knot of the first piece with σ > 0 somewhere, σ = 0 + 0 · d exactly.
+        int j = 0;
+        while (j < pieces_.count && !pieces_.opaque(j)) ++j;
+        transparentBelow_ = j == 0 ? -1.f : j == pieces_.count ? float(kSize - 1) : pieces_.knot[j];
+        return;
+    }
     // The first entry with σ > 0 (or kSize): below index first − 1 both lerped entries are 0.
     const auto first = std::find_if(entries_.begin(), entries_.end(), [](const Classified& c) { return !(c.sigma <= 0.f); });
     transparentBelow_ = float(std::distance(entries_.begin(), first)) - 1.f;
 }
 
 bool ClassificationTable::empty() const {
+    if (entries_.empty()) return true;
+    if (pieces_.count) {
+        for (int j = 0; j < pieces_.count; ++j)
+            if (pieces_.opaque(j)) return false;
+        return true;
+    }
     return std::none_of(entries_.begin(), entries_.end(), [](const Classified& c) { return c.sigma > 0.f; });
 }
 
@@ -476,7 +495,66 @@ ClassificationTable TransferFunction::bake(float valueMin, float valueMax, doubl
         entries[size_t(i)] = evaluate(float(double(i) / (ClassificationTable::kSize - 1)));
         entries[size_t(i)].sigma *= perVoxel;
     }
-    return ClassificationTable(std::move(entries), valueMin, valueMax);
+    return ClassificationTable(std::move(entries), valueMin, valueMax, pieces(perVoxel));
+}
+
+namespace {
+
+/// On [lo, hi] (no point of @p points strictly inside): the function's value at lo and its slope
+/// per unit x, in double; right-continuous at a step, as piecewise(); constant outside the points.
+template <class Point, class Get>
+std::pair<double, double> lineOn(const std::vector<Point>& points, double lo, Get get) {
+    const auto upper = std::upper_bound(points.begin(), points.end(), lo, [](double v, const Point& p) { return v < p.x; });
+    if (upper == points.begin()) return {get(points.front()), 0.0};
+    if (upper == points.end()) return {get(points.back()), 0.0};
+    const Point& a = *(upper - 1);
+    const Point& b = *upper;  // b.x > lo ≥ a.x
+    const double slope = (double(get(b)) - double(get(a))) / (double(b.x) - double(a.x));
+    return {double(get(a)) + slope * (lo - double(a.x)), slope};
+}
+
+}  // namespace
+
+LinearPieces TransferFunction::pieces(float perVoxel) const {
+    // Knots: every point's x inside (0, 1), colour and extinction alike; the pieces lie between.
+    std::vector<float> knots{0.f};
+    for (const auto& p : colors_) knots.push_back(p.x);
+    for (const auto& p : extinction_) knots.push_back(p.x);
+    std::sort(knots.begin(), knots.end());
+    knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
+    // The piece that ends at 1 reaches it; a step at 1 (two points there) needs one more piece
+    // from 1 on, so that x = 1 takes the value after the step, as evaluate(1) does.
+    const auto stepAtOne = [](const auto& points) {
+        return std::count_if(points.begin(), points.end(), [](const auto& p) { return p.x >= 1.f; }) > 1;
+    };
+    if (knots.size() > 1 && knots.back() >= 1.f && !stepAtOne(colors_) && !stepAtOne(extinction_)) knots.pop_back();
+    LinearPieces out;
+    if (knots.size() > size_t(LinearPieces::kMax) || colors_.empty() || extinction_.empty()) return out;
+    const double toIndex = ClassificationTable::kSize - 1;  // x = u · (kSize − 1)
+    out.count = int(knots.size());
+    for (int j = 0; j < out.count; ++j) {
+        const double u = knots[size_t(j)];
+        out.knot[j] = float(u * toIndex);
+        for (int c = 0; c < 3; ++c) {
+            const auto [value, slope] = lineOn(colors_, u, [c](const ColorPoint& p) { return p.rgb[c]; });
+            out.value[c][j] = float(value), out.slope[c][j] = float(slope / toIndex);
+        }
+        const auto [value, slope] = lineOn(extinction_, u, [](const ExtinctionPoint& p) { return p.sigma; });
+        out.value[3][j] = float(value * perVoxel), out.slope[3][j] = float(slope * perVoxel / toIndex);
+    }
+    return out;  // the ClassificationTable indexes it
+}
+
+void LinearPieces::index() {
+    for (int j = 0; j < kMax; ++j) next[j] = j + 1 < count ? knot[j + 1] : std::numeric_limits<float>::infinity();
+    knotsPerBucket = 0;
+    for (int b = 0; b < kMax; ++b) {
+        const float lo = float(b * kBucketWidth), hi = float((b + 1) * kBucketWidth);
+        firstOfBucket[b] = piece(lo);
+        int inside = 0;
+        for (int k = 1; k < count; ++k) inside += knot[k] > lo && knot[k] < hi;
+        knotsPerBucket = std::max(knotsPerBucket, inside);
+    }
 }
 
 std::string TransferFunction::toJson() const {

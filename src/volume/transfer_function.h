@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,13 +23,55 @@ struct Classified {
     float sigma = 0.f;     ///< extinction σ_k · h: optical depth per voxel length
 };
 
-/// @brief A baked transfer function: a dense table over the normalised value.
+/// @brief A piecewise-linear function's pieces over the table index x ∈ [0, kSize − 1]: piece j
+/// starts at knot[j] (knot[0] = 0, increasing) and runs to the next knot (the last to the end); on
+/// it, channel c (r, g, b, σ) is value[c][j] + slope[c][j] · (x − knot[j]), σ kept ≥ 0. Sixteen
+/// pieces at most, so that a vector of 16 floats (or two of 8) holds each column and a lane finds
+/// its piece's numbers by a permute instead of a gather (volume/classify-inl.h).
+struct LinearPieces {
+    static constexpr int kMax = 16;
+    /// The index range split into kMax equal buckets of kBucketWidth (bucket of x: int(x) >> 8),
+    /// so that a lane finds its piece by a permute and a few compares (volume/classify-inl.h).
+    static constexpr int kBucketShift = 8, kBucketWidth = 1 << kBucketShift;
+    int count = 0;  ///< pieces in use, 1..kMax (0: none)
+    alignas(64) float knot[kMax] = {};
+    alignas(64) float value[4][kMax] = {};  ///< r, g, b, σ at each piece's knot
+    alignas(64) float slope[4][kMax] = {};  ///< r, g, b, σ per unit of x along each piece
+    alignas(64) float next[kMax] = {};       ///< knot[j + 1]; +∞ for the last piece
+    alignas(64) int32_t firstOfBucket[kMax] = {};  ///< piece(b · kBucketWidth) of bucket b
+    int knotsPerBucket = 0;  ///< most knots strictly inside one bucket (compares after the permute)
+
+    /// The piece of index @p x: how many knots after the first lie at or below it.
+    int piece(float x) const {
+        int j = 0;
+        for (int k = 1; k < count; ++k) j += x >= knot[k];
+        return j;
+    }
+    /// The function at index @p x, in the float operations the vector form repeats.
+    Classified operator()(float x) const {
+        const int j = piece(x);
+        const float d = x - knot[j];
+        const auto at = [&](int c) { return value[c][j] + slope[c][j] * d; };
+        const float sigma = at(3);
+        return {glm::vec3(at(0), at(1), at(2)), sigma > 0.f ? sigma : 0.f};
+    }
+    /// Fills next, firstOfBucket and knotsPerBucket from count and knot.
+    void index();
+    /// True where piece @p j has σ > 0 anywhere (σ ≥ 0 at its knot, so its value or slope is).
+    bool opaque(int j) const { return value[3][j] > 0.f || slope[3][j] > 0.f; }
+};
+
+/// @brief A baked transfer function: a dense table over the normalised value, and, where the
+/// function has at most LinearPieces::kMax linear pieces, those pieces exactly.
 ///
 /// Entry i holds the function at x_i = i / (kSize − 1); a raw value v maps to the
 /// continuous index (v − valueMin) · (kSize − 1) / (valueMax − valueMin), so
 /// valueMin lands exactly on entry 0 and valueMax exactly on entry kSize − 1,
 /// and values outside the range clamp to the end entries. A degenerate range
 /// (valueMax ≤ valueMin: a grid holding one value) maps every value to x = 1.
+/// With pieces, classification evaluates them at x (the function itself, to float rounding);
+/// without, it lerps the two nearest entries (within one entry of a knot, the table rounds the
+/// knot's corner off).
 class ClassificationTable {
 public:
     static constexpr int kSize = 4096;
@@ -36,13 +79,17 @@ public:
     /// @param entries   kSize entries (x_i = i / (kSize − 1)); an empty vector classifies all to zero
     /// @param valueMin  raw value mapped to x = 0
     /// @param valueMax  raw value mapped to x = 1
-    ClassificationTable(std::vector<Classified> entries, float valueMin, float valueMax);
+    /// @param pieces    the same function's linear pieces in the index x, if it has few
+    ///                  (TransferFunction::bake); count 0: classify through the entries
+    ClassificationTable(std::vector<Classified> entries, float valueMin, float valueMax,
+                        const LinearPieces& pieces = {});
 
     /// @brief Classifies a raw voxel value (normalised with the grid's range); non-finite → all zero.
-    /// Linear interpolation between the two nearest entries; hot path, inline.
+    /// The pieces at x, else linear interpolation between the two nearest entries; hot path, inline.
     Classified operator()(float value) const {
         if (!std::isfinite(value) || entries_.empty()) return {};
         const float x = std::clamp(value * scale_ + offset_, 0.f, float(kSize - 1));
+        if (pieces_.count) return pieces_(x);
         const int i = std::min(int(x), kSize - 2);
         const float t = x - float(i);
         const Classified& a = entries_[size_t(i)];
@@ -58,15 +105,20 @@ public:
     /// @brief The kSize entries (nullptr when empty) and the index map value·scale + offset:
     /// for vectorised classification that must agree with operator() (volume/leaf_moments.h).
     const Classified* entries() const { return entries_.empty() ? nullptr : entries_.data(); }
+    /// @brief The exact pieces (count 0 when the function has more than LinearPieces::kMax, or
+    /// the table was built from entries alone).
+    const LinearPieces& pieces() const { return pieces_; }
     float scale() const { return scale_; }
     float offset() const { return offset_; }
     /// @brief Every index x < transparentBelow() (x = value·scale + offset, clamped) classifies to
-    /// σ = 0 exactly: both entries operator() lerps have σ = 0. −1 when entry 0 has σ ≠ 0 (or is
-    /// NaN); kSize − 1 when no entry is positive. Lets vectorised passes skip transparent voxels.
+    /// σ = 0 exactly: both entries operator() lerps have σ = 0, or (with pieces) its piece's σ
+    /// value and slope are 0. −1 when entry 0 (piece 0) has σ ≠ 0 (or is NaN); kSize − 1 when
+    /// nothing is positive. Lets vectorised passes skip transparent voxels.
     float transparentBelow() const { return transparentBelow_; }
 
 private:
     std::vector<Classified> entries_;
+    LinearPieces pieces_;
     float scale_ = float(kSize - 1);  ///< index = value · scale_ + offset_
     float offset_ = 0.f;
     float transparentBelow_ = -1.f;  ///< see transparentBelow()
@@ -104,6 +156,9 @@ public:
     /// @brief Bakes a table for a grid with values in [valueMin, valueMax] and voxel size @p h.
     /// @throw Error when the range is not finite or (world units) h is not finite and positive.
     ClassificationTable bake(float valueMin, float valueMax, double voxelSize) const;
+    /// @brief The function's linear pieces in the table index (σ times @p perVoxel); count 0 when
+    /// it has more than LinearPieces::kMax.
+    LinearPieces pieces(float perVoxel) const;
 
     const std::string& name() const { return name_; }
     bool worldUnits() const { return worldUnits_; }

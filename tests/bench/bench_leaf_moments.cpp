@@ -1,6 +1,8 @@
 // tests/bench/bench_leaf_moments.cpp — Google Benchmark of the level-of-detail sums of one 8³ leaf
 // (volume/leaf_moments.h): the vectorised sums at each level against the scalar classification
-// they replace (the table lookup and the σ, σ·c, σ·d, σ·d² sums voxel by voxel). Not a test: run
+// they replace (the table lookup and the σ, σ·c, σ·d, σ·d² sums voxel by voxel), classifying through
+// the table's entries (gathers) and through the linear pieces of the ct-bone preset (permutes; 10
+// pieces, values spread over all of them). Not a test: run
 //   build/bench_leaf_moments            (ns per voxel = the reported time / 512)
 #include <benchmark/benchmark.h>
 
@@ -13,7 +15,7 @@ namespace {
 using namespace vdbsplat;
 
 struct Data {
-    ClassificationTable table;
+    ClassificationTable table, pieces;
     std::vector<float> values;  // 256 leaves
     Data() : values(512 * 256) {
         std::vector<Classified> e(ClassificationTable::kSize);
@@ -22,6 +24,7 @@ struct Data {
             e[size_t(i)] = {glm::vec3(t, 1.f - t, 0.5f), 0.1f + t};
         }
         table = ClassificationTable(e, 0.f, 1.f);
+        pieces = TransferFunction::preset("ct-bone").bake(0.f, 1.f, 1.0);
         uint32_t s = 1;
         for (float& x : values) s = s * 1664525u + 1013904223u, x = float(s >> 8) / float(1 << 24);
     }
@@ -34,11 +37,12 @@ const Data& data() {
 void Vectorised(benchmark::State& state) {
     const Data& d = data();
     const int level = int(state.range(0));
+    const ClassificationTable& table = state.range(1) ? d.pieces : d.table;
     if (!leafMomentsSupported()) state.SkipWithError("no 8- or 16-lane float vectors on this CPU");
     std::array<CellMoments, 64> out;
     size_t leaf = 0;
     for (auto _ : state) {
-        leafMoments(d.values.data() + 512 * (leaf++ % 256), nullptr, d.table, level, out.data());
+        leafMoments(d.values.data() + 512 * (leaf++ % 256), nullptr, table, level, out.data());
         benchmark::DoNotOptimize(out);
     }
     state.SetItemsProcessed(int64_t(state.iterations()) * 512);
@@ -62,7 +66,7 @@ void ScalarClassifyAndSum(benchmark::State& state) {
     state.SetItemsProcessed(int64_t(state.iterations()) * 512);
 }
 
-BENCHMARK(Vectorised)->Arg(1)->Arg(2)->Arg(3);
+BENCHMARK(Vectorised)->ArgNames({"level", "pieces"})->ArgsProduct({{1, 2, 3}, {0, 1}});
 BENCHMARK(ScalarClassifyAndSum);
 }  // namespace
 

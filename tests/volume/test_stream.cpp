@@ -522,7 +522,7 @@ namespace {
 // The vectorised whole-leaf sums against the same sums in double, one voxel at a time: a
 // partly active leaf (mask words), a dense one (no mask), values outside the table's range,
 // NaN and infinity (σ = 0, not counted), and a colour-varying table.
-void expectLeafMomentsMatchTheSums();
+void expectLeafMomentsMatchTheSums(const ClassificationTable& table);
 
 /// Runs @p body on the widest target this CPU has, and again on AVX2 (8 lanes: one row per
 /// vector, lane pairs of 4 doubles) where the CPU has wider ones, so that both row layouts of the
@@ -556,6 +556,19 @@ ClassificationTable leafTestTable(float clearBelow) {
     return ClassificationTable(entries, -0.5f, 2.f);
 }
 
+/// A transfer function of 13 linear pieces over values in [−0.5, 2] (more than one vector of 8
+/// lanes holds), three knots inside one bucket of LinearPieces (the compares after the permute),
+/// steps in colour and σ, σ = 0 below x = 0.15: the vector passes' classification by pieces.
+ClassificationTable piecesTestTable() {
+    const auto tf = TransferFunction::fromPoints(
+        "pieces",
+        {{0.f, glm::vec3(0.1f, 0.9f, 0.2f)}, {0.3f, glm::vec3(0.8f, 0.1f, 0.3f)}, {0.31f, glm::vec3(0.2f)},
+         {0.5f, glm::vec3(0.2f)}, {0.5f, glm::vec3(1.f, 0.5f, 0.f)}, {0.9f, glm::vec3(0.f, 0.3f, 1.f)}},
+        {{0.15f, 0.f}, {0.2f, 0.4f}, {0.305f, 0.1f}, {0.32f, 1.5f}, {0.45f, 0.2f}, {0.6f, 0.3f}, {0.6f, 0.9f},
+         {0.7f, 0.05f}, {0.8f, 2.f}, {0.85f, 0.f}, {0.95f, 0.6f}, {1.f, 0.6f}});
+    return tf.bake(-0.5f, 2.f, 1.0);
+}
+
 /// One random 8³ leaf: values in [−1, 3), a NaN and an @p infinity at places that move with
 /// @p trial, each voxel active with probability @p activeShare (the mask words); @p state is the
 /// generator's, carried from leaf to leaf.
@@ -575,10 +588,18 @@ RandomLeaf randomLeaf(int trial, uint32_t& state, float infinity, float activeSh
     return leaf;
 }
 
-TEST(LeafMoments, MatchTheSumsVoxelByVoxel) { onBestAndAvx2(leafMomentsSupported, expectLeafMomentsMatchTheSums); }
+TEST(LeafMoments, MatchTheSumsVoxelByVoxel) {
+    onBestAndAvx2(leafMomentsSupported, [] { expectLeafMomentsMatchTheSums(leafTestTable(0.1f)); });
+}
 
-void expectLeafMomentsMatchTheSums() {
-    const ClassificationTable table = leafTestTable(0.1f);
+TEST(LeafMoments, MatchTheSumsThroughLinearPieces) {
+    const ClassificationTable table = piecesTestTable();
+    ASSERT_GT(table.pieces().count, 8);
+    ASSERT_GE(table.pieces().knotsPerBucket, 2);
+    onBestAndAvx2(leafMomentsSupported, [&] { expectLeafMomentsMatchTheSums(table); });
+}
+
+void expectLeafMomentsMatchTheSums(const ClassificationTable& table) {
     uint32_t state = 99;
     for (int trial = 0; trial < 40; ++trial) {
         const auto [values, words] = randomLeaf(trial, state, -std::numeric_limits<float>::infinity(), 0.7f);
@@ -624,9 +645,18 @@ void expectLeafMomentsMatchTheSums() {
 // table, not masked off), its view position and distance in glm's double order rounded to
 // float, σ and colour as ClassificationTable::operator(). Partly active and dense leaves, a
 // camera off every axis; on the widest target and on AVX2 (one row per vector) where wider exist.
-void expectLeafExtractionMatchesTheVoxels();
+void expectLeafExtractionMatchesTheVoxels(const ClassificationTable& table);
 
-TEST(LeafExtract, EqualsTheVoxelByVoxelRecords) { onBestAndAvx2(leafExtractSupported, expectLeafExtractionMatchesTheVoxels); }
+TEST(LeafExtract, EqualsTheVoxelByVoxelRecords) {
+    onBestAndAvx2(leafExtractSupported, [] { expectLeafExtractionMatchesTheVoxels(leafTestTable(0.3f)); });
+}
+
+// The same through a table's linear pieces: σ and colour equal LinearPieces::operator() bit for bit.
+TEST(LeafExtract, EqualsTheVoxelByVoxelRecordsThroughLinearPieces) {
+    const ClassificationTable table = piecesTestTable();
+    ASSERT_GT(table.pieces().count, 8);
+    onBestAndAvx2(leafExtractSupported, [&] { expectLeafExtractionMatchesTheVoxels(table); });
+}
 
 // In the stream: the same records, window by window, with the vectorised extraction as with the
 // voxel-by-voxel path (StreamOptions::vectorExtract), at a framed view where every block is voxels.
@@ -646,8 +676,7 @@ TEST(LeafExtract, StreamRecordsEqualTheVoxelByVoxelPath) {
     EXPECT_EQ(runs[0], runs[1]);
 }
 
-void expectLeafExtractionMatchesTheVoxels() {
-    const ClassificationTable table = leafTestTable(0.3f);
+void expectLeafExtractionMatchesTheVoxels(const ClassificationTable& table) {
     // An index-to-view transform off every axis, with a translation and an uneven scale (as
     // VoxelStream's worldToView · indexToWorld; any affine map).
     glm::dmat4 indexToView(1.0);

@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "image/image.h"
 #include "util/error.h"
@@ -162,6 +164,67 @@ TEST(TransferFunctionBake, TableMatchesEvaluateOverTheRange) {
             expectSame(table(v), tf.evaluate((v - lo) / (hi - lo)), 5e-4f);
         }
     }
+}
+
+// The presets (at most 16 linear pieces) classify through their pieces: the function itself to
+// float rounding, kinks included, where the table's lerp rounds each kink over one entry. Steps
+// (two points at one x, inside and at 1) take the later value at the step, as evaluate() does;
+// world units scale σ; every x below transparentBelow() is σ = 0 exactly.
+TEST(TransferFunctionBake, PiecesAreTheFunctionKinksAndStepsIncluded) {
+    const float lo = -3.f, hi = 7.f;
+    auto functions = std::vector<TransferFunction>{};
+    for (const auto& name : TransferFunction::presetNames()) functions.push_back(TransferFunction::preset(name));
+    functions.push_back(TransferFunction::fromPoints("steps", {{0.f, glm::vec3(0.f)}, {0.3f, glm::vec3(0.2f, 0.9f, 0.4f)},
+                                                               {0.3f, glm::vec3(1.f)}, {1.f, glm::vec3(0.5f)}},
+                                                     {{0.2f, 0.f}, {0.6f, 0.7f}, {0.6f, 0.1f}, {1.f, 0.3f}, {1.f, 2.f}}, true));
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    for (const TransferFunction& tf : functions) {
+        SCOPED_TRACE(tf.name());
+        const double h = 0.5;
+        const ClassificationTable table = tf.bake(lo, hi, h);
+        const LinearPieces& pieces = table.pieces();
+        ASSERT_GE(pieces.count, 1);
+        const float perVoxel = tf.worldUnits() ? float(h) : 1.f;
+        const auto expectFunction = [&](float x) {
+            const float v = lo + x * (hi - lo);
+            const float at = (table.indexOf(v)) / float(ClassificationTable::kSize - 1);  // x as the table sees it
+            Classified want = tf.evaluate(std::clamp(at, 0.f, 1.f));
+            want.sigma *= perVoxel;
+            expectSame(table(v), want, 2e-6f);
+            if (table.indexOf(v) < table.transparentBelow()) EXPECT_EQ(table(v).sigma, 0.f) << x;
+        };
+        for (int n = 0; n < 20000; ++n) expectFunction(u(rng));
+        // Either side of every knot, within one table entry (where the table's lerp is off by
+        // ~Δslope / 4095 / 4, beyond the tolerance for ct-bone's kinks).
+        for (const float delta : {-3e-5f, 3e-5f}) {
+            for (const auto& p : tf.colors()) expectFunction(std::clamp(p.x + delta, 0.f, 1.f));
+            for (const auto& p : tf.extinction()) expectFunction(std::clamp(p.x + delta, 0.f, 1.f));
+        }
+    }
+    const ClassificationTable steps = functions.back().bake(0.f, 1.f, 1.0);
+    EXPECT_FLOAT_EQ(steps(0.3f).color.y, 1.f);
+    EXPECT_NEAR(steps(0.2999f).color.y, 0.9f, 1e-3f);
+    EXPECT_FLOAT_EQ(steps(1.f).sigma, 2.f);  // the step at 1: the last point
+    EXPECT_NEAR(steps(0.9999f).sigma, 0.3f, 1e-3f);
+    EXPECT_EQ(steps(0.2f).sigma, 0.f);
+    EXPECT_EQ(steps.transparentBelow(), steps.pieces().knot[1]);  // σ rises from x = 0.2
+}
+
+// More than 16 pieces: no pieces, the table's lerp (its error bound); an all-zero σ is empty.
+TEST(TransferFunctionBake, ManyPointsClassifyThroughTheTable) {
+    std::vector<TransferFunction::ExtinctionPoint> sigma;
+    for (int k = 0; k <= 20; ++k) sigma.push_back({float(k) / 20.f, float(k % 2)});
+    const auto tf = TransferFunction::fromPoints("saw", {{0.f, glm::vec3(1.f)}}, sigma);
+    const ClassificationTable table = tf.bake(0.f, 1.f, 1.0);
+    EXPECT_EQ(table.pieces().count, 0);
+    for (int n = 0; n <= 1000; ++n) {
+        const float x = float(n) / 1000.f;
+        expectSame(table(x), tf.evaluate(x), 20.f / 4095.f);  // slope 20: one entry's rounding of a kink
+    }
+    const auto zero = TransferFunction::fromPoints("z", {{0.f, glm::vec3(1.f)}, {0.5f, glm::vec3(0.f)}}, {{0.3f, 0.f}});
+    EXPECT_GT(zero.bake(0.f, 1.f, 1.0).pieces().count, 0);
+    EXPECT_TRUE(zero.bake(0.f, 1.f, 1.0).empty());
 }
 
 TEST(TransferFunctionBake, BothEndsOfTheRangeMapExactly) {
