@@ -518,8 +518,8 @@ void forEachRow(const auto& b, const Volume& volume, const ClassificationTable& 
 // ≤ 3.5 voxels) so the float sums do not cancel, row by row: along a row of the block (z) the
 // offsets dx and dy are constant, so the row's Σσ, Σσ·dz and Σσ·dz² give every moment
 // (Σσ·dx·dz = dx·Σσ·dz, Σσ·dx² = dx²·Σσ, ...): three sums per voxel instead of ten.
-// The grid (its file, name, tree, voxel count and transform) and the baked table (its entries and
-// index map): what a block's moments depend on. A different grid or transfer function empties
+// The grid (its file, name, tree, voxel count and transform) and the baked table (its entries,
+// linear pieces and index map): what a block's moments depend on. A different grid or transfer function empties
 // the kept slots.
 void VoxelStream::prepareMomentCache(size_t blocks) {
     LodMomentCache& cache = *moments_;
@@ -533,6 +533,11 @@ void VoxelStream::prepareMomentCache(size_t blocks) {
     key = fnv1a64(table_.entries(), sizeof(Classified) * ClassificationTable::kSize, key);
     const float map[2] = {table_.scale(), table_.offset()};
     key = fnv1a64(map, sizeof map, key);
+    const LinearPieces& pieces = table_.pieces();  // what classifies, where it has pieces (not its padding)
+    key = fnv1a64(&pieces.count, sizeof pieces.count, key);
+    key = fnv1a64(pieces.knot, sizeof pieces.knot, key);
+    key = fnv1a64(pieces.value, sizeof pieces.value, key);
+    key = fnv1a64(pieces.slope, sizeof pieces.slope, key);
     const uint8_t path = options_.vectorLeafMoments ? 1 : 0;  // the vector and the scalar sums round apart
     key = fnv1a64(&path, sizeof path, key) | 1;  // never 0 (none yet)
     if (cache.key == key && cache.blocks == blocks) return;

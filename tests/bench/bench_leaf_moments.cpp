@@ -1,8 +1,9 @@
 // tests/bench/bench_leaf_moments.cpp — Google Benchmark of the level-of-detail sums of one 8³ leaf
 // (volume/leaf_moments.h): the vectorised sums at each level against the scalar classification
 // they replace (the table lookup and the σ, σ·c, σ·d, σ·d² sums voxel by voxel), classifying through
-// the table's entries (gathers) and through the linear pieces of the ct-bone preset (permutes; 10
-// pieces, values spread over all of them). Not a test: run
+// the table's entries (pieces:0, gathers), through the linear pieces of the ct-bone preset
+// (pieces:1, permutes; 10 pieces, values spread over all of them), and through grey's one piece
+// (pieces:2). Not a test: run
 //   build/bench_leaf_moments            (ns per voxel = the reported time / 512)
 #include <benchmark/benchmark.h>
 
@@ -15,7 +16,7 @@ namespace {
 using namespace vdbsplat;
 
 struct Data {
-    ClassificationTable table, pieces;
+    ClassificationTable table, pieces, line;
     std::vector<float> values;  // 256 leaves
     Data() : values(512 * 256) {
         std::vector<Classified> e(ClassificationTable::kSize);
@@ -25,6 +26,7 @@ struct Data {
         }
         table = ClassificationTable(e, 0.f, 1.f);
         pieces = TransferFunction::preset("ct-bone").bake(0.f, 1.f, 1.0);
+        line = TransferFunction::preset("grey").bake(0.f, 1.f, 1.0);  // one piece
         uint32_t s = 1;
         for (float& x : values) s = s * 1664525u + 1013904223u, x = float(s >> 8) / float(1 << 24);
     }
@@ -37,7 +39,7 @@ const Data& data() {
 void Vectorised(benchmark::State& state) {
     const Data& d = data();
     const int level = int(state.range(0));
-    const ClassificationTable& table = state.range(1) ? d.pieces : d.table;
+    const ClassificationTable& table = state.range(1) == 0 ? d.table : state.range(1) == 1 ? d.pieces : d.line;
     if (!leafMomentsSupported()) state.SkipWithError("no 8- or 16-lane float vectors on this CPU");
     std::array<CellMoments, 64> out;
     size_t leaf = 0;
@@ -66,7 +68,7 @@ void ScalarClassifyAndSum(benchmark::State& state) {
     state.SetItemsProcessed(int64_t(state.iterations()) * 512);
 }
 
-BENCHMARK(Vectorised)->ArgNames({"level", "pieces"})->ArgsProduct({{1, 2, 3}, {0, 1}});
+BENCHMARK(Vectorised)->ArgNames({"level", "pieces"})->ArgsProduct({{1, 2, 3}, {0, 1, 2}});
 BENCHMARK(ScalarClassifyAndSum);
 }  // namespace
 

@@ -408,6 +408,12 @@ TEST(Stream, KeptMomentsAreReadAndFollowTheTable) {
     EXPECT_NE(streamRecords(v, far, a, &kept), streamRecords(v, far, a, nullptr));
     EXPECT_EQ(streamRecords(v, far, b, &kept), streamRecords(v, far, b, nullptr));  // another table: emptied
     EXPECT_EQ(streamRecords(v, far, b, &kept), streamRecords(v, far, b, nullptr));
+    // b's entries with linear pieces (one, σ = 0.5 everywhere): classified by the pieces, so emptied too.
+    LinearPieces flat;
+    flat.count = 1;
+    flat.value[3][0] = 0.5f;
+    const ClassificationTable c(std::vector<Classified>(b.entries(), b.entries() + ClassificationTable::kSize), 0.f, 1.f, flat);
+    EXPECT_EQ(streamRecords(v, far, c, &kept), streamRecords(v, far, c, nullptr));
 }
 
 // Blended levels (StreamOptions::lodBlend): along a zoom through every level change the leaves
