@@ -542,6 +542,10 @@ LinearPieces TransferFunction::pieces(float perVoxel) const {
         const auto [value, slope] = lineOn(extinction_, u, [](const ExtinctionPoint& p) { return p.sigma; });
         out.value[3][j] = float(value * perVoxel), out.slope[3][j] = float(slope * perVoxel / toIndex);
     }
+    // A slope past float's range (a huge σ over knots ulps apart) would make ∞ · 0: the table then.
+    for (int c = 0; c < 4; ++c)
+        for (int j = 0; j < out.count; ++j)
+            if (!std::isfinite(out.value[c][j]) || !std::isfinite(out.slope[c][j])) return LinearPieces{};
     return out;  // the ClassificationTable indexes it
 }
 

@@ -222,6 +222,11 @@ TEST(TransferFunctionBake, ManyPointsClassifyThroughTheTable) {
         const float x = float(n) / 1000.f;
         expectSame(table(x), tf.evaluate(x), 20.f / 4095.f);  // slope 20: one entry's rounding of a kink
     }
+    // A slope beyond float's range (σ near FLT_MAX across two knots a few ulps apart): the table.
+    const auto cliff = TransferFunction::fromPoints("cliff", {{0.f, glm::vec3(1.f)}},
+                                                    {{0.5f, 0.f}, {std::nextafter(0.5f, 1.f), 3e38f}});
+    EXPECT_EQ(cliff.bake(0.f, 1.f, 1.0).pieces().count, 0);
+    EXPECT_EQ(cliff.bake(0.f, 1.f, 1.0)(1.f).sigma, 3e38f);
     const auto zero = TransferFunction::fromPoints("z", {{0.f, glm::vec3(1.f)}, {0.5f, glm::vec3(0.f)}}, {{0.3f, 0.f}});
     EXPECT_GT(zero.bake(0.f, 1.f, 1.0).pieces().count, 0);
     EXPECT_TRUE(zero.bake(0.f, 1.f, 1.0).empty());
