@@ -87,7 +87,8 @@ struct ClassifyLanes {
         r = lerp(r0, r1), g = lerp(g0, g1), b = lerp(b0, b1);
     }
 
-    /// As operator(), by LinearPieces::operator(): each lane's piece j is its bucket's first
+    /// As operator(), by LinearPieces::operator() (x − knot[0] = x: knot[0] = 0). One piece: its
+    /// numbers broadcast. More: each lane's piece j is its bucket's first
     /// piece, plus one for each following knot at or below x (knotsPerBucket compares); its knot,
     /// values and slopes are permuted out of the pieces' columns (one vector of 16, or two of 8
     /// and a blend); then value + slope · (x − knot).
@@ -105,15 +106,22 @@ struct ClassifyLanes {
             else return hn::IfThenElse(hn::RebindMask(tag, hn::Gt(j, hn::Set(di, kLanes - 1))),
                                        hn::TableLookupLanes(hn::Load(tag, c + kLanes), low), lo);
         };
+        // value + slope · dx per channel, from the lanes' values and slopes.
+        const auto evaluate = [&](auto value, auto slope, V dx) {
+            const auto channel = [&](int c) { return hn::Add(value(c), hn::Mul(slope(c), dx)); };
+            r = channel(0), g = channel(1), b = channel(2);
+            const V s = channel(3);
+            sigma = hn::IfThenElseZero(hn::And(active, hn::Gt(s, zero)), s);
+        };
+        if (pieces->count == 1)  // one line (grey): its numbers broadcast, no permutes
+            return evaluate([&](int c) { return hn::Set(d, pieces->value[c][0]); },
+                            [&](int c) { return hn::Set(d, pieces->slope[c][0]); }, x);
         auto j = column(di, pieces->firstOfBucket, hn::ShiftRight<LinearPieces::kBucketShift>(hn::ConvertTo(di, x)));
         for (int k = 0; k < pieces->knotsPerBucket; ++k)  // j += (x ≥ next knot): the mask as −1
             j = hn::Sub(j, hn::VecFromMask(di, hn::RebindMask(di, hn::Ge(x, column(d, pieces->next, j)))));
         const auto at = [&](const float* c) { return column(d, c, j); };
-        const V dx = hn::Sub(x, at(pieces->knot));
-        const auto channel = [&](int c) { return hn::Add(at(pieces->value[c]), hn::Mul(at(pieces->slope[c]), dx)); };
-        r = channel(0), g = channel(1), b = channel(2);
-        const V s = channel(3);
-        sigma = hn::IfThenElseZero(hn::And(active, hn::Gt(s, zero)), s);
+        evaluate([&](int c) { return at(pieces->value[c]); }, [&](int c) { return at(pieces->slope[c]); },
+                 hn::Sub(x, at(pieces->knot)));
     }
 };
 

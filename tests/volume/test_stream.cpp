@@ -657,11 +657,17 @@ TEST(LeafExtract, EqualsTheVoxelByVoxelRecords) {
     onBestAndAvx2(leafExtractSupported, [] { expectLeafExtractionMatchesTheVoxels(leafTestTable(0.3f)); });
 }
 
-// The same through a table's linear pieces: σ and colour equal LinearPieces::operator() bit for bit.
+// The same through a table's linear pieces: σ and colour equal LinearPieces::operator() bit for
+// bit, with many pieces and with one (grey's line, broadcast instead of permuted).
 TEST(LeafExtract, EqualsTheVoxelByVoxelRecordsThroughLinearPieces) {
     const ClassificationTable table = piecesTestTable();
     ASSERT_GT(table.pieces().count, 8);
     onBestAndAvx2(leafExtractSupported, [&] { expectLeafExtractionMatchesTheVoxels(table); });
+    const ClassificationTable line = TransferFunction::fromPoints("line", {{0.f, glm::vec3(0.9f, 0.2f, 0.f)}, {1.f, glm::vec3(0.1f, 0.6f, 1.f)}},
+                                                                  {{0.f, 0.f}, {1.f, 0.7f}})
+                                         .bake(-0.5f, 2.f, 1.0);
+    ASSERT_EQ(line.pieces().count, 1);
+    onBestAndAvx2(leafExtractSupported, [&] { expectLeafExtractionMatchesTheVoxels(line); });
 }
 
 // In the stream: the same records, window by window, with the vectorised extraction as with the
