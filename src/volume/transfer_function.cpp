@@ -554,7 +554,7 @@ void LinearPieces::index() {
     knotsPerBucket = 0;
     for (int b = 0; b < kMax; ++b) {
         const float lo = float(b * kBucketWidth), hi = float((b + 1) * kBucketWidth);
-        firstOfBucket[b] = piece(lo);
+        firstOfBucket[b] = countKnots(lo);
         int inside = 0;
         for (int k = 1; k < count; ++k) inside += knot[k] > lo && knot[k] < hi;
         knotsPerBucket = std::max(knotsPerBucket, inside);

@@ -41,8 +41,15 @@ struct LinearPieces {
     alignas(64) int32_t firstOfBucket[kMax] = {};  ///< piece(b · kBucketWidth) of bucket b
     int knotsPerBucket = 0;  ///< most knots strictly inside one bucket (compares after the permute)
 
-    /// The piece of index @p x: how many knots after the first lie at or below it.
+    /// The piece of index @p x ∈ [0, kMax · kBucketWidth): how many knots after the first lie at
+    /// or below it, from its bucket's first piece on (index() must have run).
     int piece(float x) const {
+        int j = firstOfBucket[int(x) >> kBucketShift];
+        while (x >= next[j]) ++j;  // next[count − 1] = +∞
+        return j;
+    }
+    /// piece() by counting every knot (index() builds the buckets with it).
+    int countKnots(float x) const {
         int j = 0;
         for (int k = 1; k < count; ++k) j += x >= knot[k];
         return j;

@@ -192,7 +192,9 @@ TEST(TransferFunctionBake, PiecesAreTheFunctionKinksAndStepsIncluded) {
             Classified want = tf.evaluate(std::clamp(at, 0.f, 1.f));
             want.sigma *= perVoxel;
             expectSame(table(v), want, 2e-6f);
-            if (table.indexOf(v) < table.transparentBelow()) EXPECT_EQ(table(v).sigma, 0.f) << x;
+            if (table.indexOf(v) < table.transparentBelow()) {
+                EXPECT_EQ(table(v).sigma, 0.f) << x;
+            }
         };
         for (int n = 0; n < 20000; ++n) expectFunction(u(rng));
         // Either side of every knot, within one table entry (where the table's lerp is off by
