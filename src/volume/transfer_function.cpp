@@ -396,9 +396,10 @@ ClassificationTable::ClassificationTable(std::vector<Classified> entries, float 
     if (!entries_.empty() && entries_.size() != size_t(kSize))
         throw Error("classification table: expected " + std::to_string(kSize) + " entries, got " +
                     std::to_string(entries_.size()));
-    if (pieces_.count < 0 || pieces_.count > LinearPieces::kMax || pieces_.knot[0] != 0.f)
-        throw Error("classification table: pieces must number 0.." + std::to_string(LinearPieces::kMax) +
-                    " and start at index 0");
+    if (!pieces_.valid())
+        throw Error("classification table: linear pieces must number 0.." + std::to_string(LinearPieces::kMax) +
+                    ", start at index 0 with knots not decreasing below " + std::to_string(kSize - 1) +
+                    ", and hold finite values and slopes");
     if (pieces_.count) {
         static_assert(LinearPieces::kMax * LinearPieces::kBucketWidth == kSize, "the buckets cover the table");
         pieces_.index();
@@ -543,10 +544,17 @@ LinearPieces TransferFunction::pieces(float perVoxel) const {
         out.value[3][j] = float(value * perVoxel), out.slope[3][j] = float(slope * perVoxel / toIndex);
     }
     // A slope past float's range (a huge σ over knots ulps apart) would make ∞ · 0: the table then.
-    for (int c = 0; c < 4; ++c)
-        for (int j = 0; j < out.count; ++j)
-            if (!std::isfinite(out.value[c][j]) || !std::isfinite(out.slope[c][j])) return LinearPieces{};
-    return out;  // the ClassificationTable indexes it
+    return out.valid() ? out : LinearPieces{};  // the ClassificationTable indexes it
+}
+
+bool LinearPieces::valid() const {
+    if (count < 0 || count > kMax || (count > 0 && knot[0] != 0.f)) return false;
+    for (int j = 0; j < count; ++j) {
+        if (!(knot[j] >= (j ? knot[j - 1] : 0.f) && knot[j] <= float(ClassificationTable::kSize - 1))) return false;
+        for (int c = 0; c < 4; ++c)
+            if (!std::isfinite(value[c][j]) || !std::isfinite(slope[c][j])) return false;
+    }
+    return true;
 }
 
 void LinearPieces::index() {

@@ -62,6 +62,8 @@ struct LinearPieces {
         const float sigma = at(3);
         return {glm::vec3(at(0), at(1), at(2)), sigma > 0.f ? sigma : 0.f};
     }
+    /// count in 0..kMax; knots from 0, not decreasing, at most kSize − 1; finite values, slopes.
+    bool valid() const;
     /// Fills next, firstOfBucket and knotsPerBucket from count and knot.
     void index();
     /// True where piece @p j has σ > 0 anywhere (σ ≥ 0 at its knot, so its value or slope is).

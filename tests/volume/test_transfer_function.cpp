@@ -232,6 +232,14 @@ TEST(TransferFunctionBake, ManyPointsClassifyThroughTheTable) {
     const auto zero = TransferFunction::fromPoints("z", {{0.f, glm::vec3(1.f)}, {0.5f, glm::vec3(0.f)}}, {{0.3f, 0.f}});
     EXPECT_GT(zero.bake(0.f, 1.f, 1.0).pieces().count, 0);
     EXPECT_TRUE(zero.bake(0.f, 1.f, 1.0).empty());
+    // Pieces handed to a table are checked: knots out of order, or a slope that is not finite.
+    LinearPieces bad;
+    bad.count = 2, bad.knot[1] = 5000.f;
+    EXPECT_NE(errorOf([&] { ClassificationTable(std::vector<Classified>(ClassificationTable::kSize), 0.f, 1.f, bad); })
+                  .find("linear pieces"), std::string::npos);
+    bad.knot[1] = 100.f, bad.slope[3][1] = INFINITY;
+    EXPECT_NE(errorOf([&] { ClassificationTable(std::vector<Classified>(ClassificationTable::kSize), 0.f, 1.f, bad); })
+                  .find("linear pieces"), std::string::npos);
 }
 
 TEST(TransferFunctionBake, BothEndsOfTheRangeMapExactly) {
