@@ -378,7 +378,7 @@ struct MomentScratch {
 // is counted once.
 void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts, const uint64_t* visible) const {
     if (b.lodLevel == 0) return extractVoxels(b, nullptr, out, visible);
-    MomentScratch scratch;  // not zeroed: cellMoments fills what it hands back
+    MomentScratch scratch;  // not zeroed: computeCellMoments writes every cell
     if (!(b.lodFine > 0.f)) return emitCells(b, b.lodLevel, cellMoments(b, b.lodLevel, scratch.cells), nullptr, false, out, counts);
     const int k = b.lodLevel, parents = kBlockDim >> k;
     // From the voxels, cell by cell (drawing a block twice would cost its voxels again); between
@@ -572,7 +572,6 @@ bool VoxelStream::momentsKept(const Block& b) const {
 PackedCells VoxelStream::cellMoments(const Block& b, int level, CellMoments* scratch) const {
     const int count = (b.dim >> level) * (b.dim >> level) * (b.dim >> level);
     if (!keepsLevel(b, level)) {
-        std::fill_n(scratch, count, CellMoments{});  // the sums start from zero
         computeCellMoments(b, level, scratch);
         return cellsWithMass(scratch, count);
     }
@@ -580,7 +579,6 @@ PackedCells VoxelStream::cellMoments(const Block& b, int level, CellMoments* scr
     const size_t l = size_t(level - 1);
     uint8_t& have = cache.have[l][b.id];
     if (!have) {
-        std::fill_n(scratch, count, CellMoments{});
         computeCellMoments(b, level, scratch);
         const PackedCells found = cellsWithMass(scratch, count);
         const size_t at = cache.cursor[l].fetch_add(size_t(std::popcount(found.mask)), std::memory_order_relaxed);
@@ -603,8 +601,11 @@ void VoxelStream::computeCellMoments(const Block& b, int level, CellMoments* acc
         const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE;
         std::array<uint64_t, 8> words;
         for (int x = 0; x < 8; ++x) words[size_t(x)] = b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));
-        leafMoments(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, level, acc);
-    } else forEachRow(b, volume_, table_, shader_, emission_, [&](int x, int y, const std::array<float, kBlockDim>& sigma, const std::array<glm::vec3, kBlockDim>& color) {
+        leafMoments(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, level, acc);  // writes every cell
+        return;
+    }
+    std::fill_n(acc, cells * cells * cells, Moments{});  // the row sums below add to zero
+    forEachRow(b, volume_, table_, shader_, emission_, [&](int x, int y, const std::array<float, kBlockDim>& sigma, const std::array<glm::vec3, kBlockDim>& color) {
         const float dx = float(x & (side - 1)) - half, dy = float(y & (side - 1)) - half;
         Moments* row = &acc[size_t(((x >> level) * cells + (y >> level)) * cells)];
         for (int cz = 0; cz < cells; ++cz) {

@@ -268,7 +268,7 @@ private:
     PackedCells cellMoments(const Block& b, int level, CellMoments* scratch) const;
     bool keepsLevel(const Block& b, int level) const;  // this level's cells of b are kept between renders
     bool momentsKept(const Block& b) const;  // drawn at one level from kept cells (reads no voxel)
-    void computeCellMoments(const Block& b, int level, CellMoments* acc) const;
+    void computeCellMoments(const Block& b, int level, CellMoments* acc) const;  // writes all of b's cells at level
     void prepareMomentCache(size_t blocks);  // keys (or empties) the kept moments for this grid and table
     void emitCells(const Block& b, int level, PackedCells acc, const float* coarse, bool fineSide,
                    VoxelBatch& out, StreamCounts& counts) const;
