@@ -409,7 +409,9 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts,
                 parentWeight[size_t((cx * cells + cy) * cells + cz)] =
                     coarse[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
     emitCells(b, level, fine, parentWeight.data(), true, out, counts);
-    std::array<CellMoments, 64> up{};
+    MomentScratch parentsScratch;  // only the parents³ cells used are zeroed (8 or 1: not all 64, 3.8 KB)
+    CellMoments* up = parentsScratch.cells;
+    std::fill_n(up, parents * parents * parents, CellMoments{});
     int j = 0;
     for (uint64_t bits = fine.mask; bits != 0; bits &= bits - 1, ++j) {
         const int i = std::countr_zero(bits), cx = i / (cells * cells), cy = (i / cells) % cells, cz = i % cells;
@@ -427,7 +429,7 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts,
         p.yz += a.yz + o.y * a.first.z + o.z * a.first.y + a.m * o.y * o.z;
         p.n += a.n;
     }
-    emitCells(b, k, cellsWithMass(up.data(), parents * parents * parents), coarse.data(), false, out, counts);
+    emitCells(b, k, cellsWithMass(up, parents * parents * parents), coarse.data(), false, out, counts);
 }
 
 // coarse: per level-1 cell (x>>1, y>>1, z>>1) its weight w_c at level 1; the voxels take 1 − w_c
