@@ -13,6 +13,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "image/image.h"
 #include "util/error.h"
@@ -80,18 +81,32 @@ void checkNesting(const std::string& text, const std::string& origin) {
 
 // --- Piecewise-linear evaluation --------------------------------------------
 
+/// The points {x, value} (x non-decreasing) around @p x: the last with p.x ≤ x and the first
+/// with p.x > x (so at a jump, two equal x, the later point is the first); null past an end.
+template <typename Point>
+std::pair<const Point*, const Point*> around(const std::vector<Point>& points, double x) {
+    const auto upper = std::upper_bound(points.begin(), points.end(), x, [](double v, const Point& p) { return v < p.x; });
+    return {upper == points.begin() ? nullptr : &*(upper - 1), upper == points.end() ? nullptr : &*upper};
+}
+
 /// Evaluates points {x, value} (x non-decreasing) at @p x: linear between points,
 /// constant beyond the ends; at a jump (two equal x) the later point wins.
 template <typename Point, typename Get>
 auto piecewise(const std::vector<Point>& points, float x, Get get) -> decltype(get(points.front())) {
-    const auto upper = std::upper_bound(points.begin(), points.end(), x,
-                                        [](float v, const Point& p) { return v < p.x; });
-    if (upper == points.begin()) return get(points.front());
-    if (upper == points.end()) return get(points.back());
-    const Point& a = *(upper - 1);
-    const Point& b = *upper;
-    const float t = (x - a.x) / (b.x - a.x);  // b.x > a.x: upper_bound skipped equal x
-    return get(a) + t * (get(b) - get(a));
+    const auto [a, b] = around(points, x);
+    if (!a || !b) return get(a ? *a : *b);
+    const float t = (x - a->x) / (b->x - a->x);  // b.x > a.x: upper_bound skipped equal x
+    return get(*a) + t * (get(*b) - get(*a));
+}
+
+/// On [lo, next point): the function's value at lo and its slope per unit x, in double, as
+/// piecewise() (right-continuous at a jump, constant beyond the ends).
+template <class Point, class Get>
+std::pair<double, double> lineOn(const std::vector<Point>& points, double lo, Get get) {
+    const auto [a, b] = around(points, lo);
+    if (!a || !b) return {get(a ? *a : *b), 0.0};
+    const double slope = (double(get(*b)) - double(get(*a))) / (double(b->x) - double(a->x));
+    return {double(get(*a)) + slope * (lo - double(a->x)), slope};
 }
 
 // --- Validation (shared by files, ParaView maps and fromPoints) -------------
@@ -404,8 +419,7 @@ ClassificationTable::ClassificationTable(std::vector<Classified> entries, float 
         static_assert(LinearPieces::kMax * LinearPieces::kBucketWidth == kSize, "the buckets cover the table");
         pieces_.index();
         // Below the knot of the first piece with σ > 0 somewhere, σ = 0 + 0 · d exactly.
-        int j = 0;
-        while (j < pieces_.count && !pieces_.opaque(j)) ++j;
+        const int j = pieces_.firstOpaque();
         transparentBelow_ = j == 0 ? -1.f : j == pieces_.count ? float(kSize - 1) : pieces_.knot[j];
         return;
     }
@@ -416,11 +430,7 @@ ClassificationTable::ClassificationTable(std::vector<Classified> entries, float 
 
 bool ClassificationTable::empty() const {
     if (entries_.empty()) return true;
-    if (pieces_.count) {
-        for (int j = 0; j < pieces_.count; ++j)
-            if (pieces_.opaque(j)) return false;
-        return true;
-    }
+    if (pieces_.count) return pieces_.firstOpaque() == pieces_.count;
     return std::none_of(entries_.begin(), entries_.end(), [](const Classified& c) { return c.sigma > 0.f; });
 }
 
@@ -499,23 +509,6 @@ ClassificationTable TransferFunction::bake(float valueMin, float valueMax, doubl
     return ClassificationTable(std::move(entries), valueMin, valueMax, pieces(perVoxel));
 }
 
-namespace {
-
-/// On [lo, hi] (no point of @p points strictly inside): the function's value at lo and its slope
-/// per unit x, in double; right-continuous at a step, as piecewise(); constant outside the points.
-template <class Point, class Get>
-std::pair<double, double> lineOn(const std::vector<Point>& points, double lo, Get get) {
-    const auto upper = std::upper_bound(points.begin(), points.end(), lo, [](double v, const Point& p) { return v < p.x; });
-    if (upper == points.begin()) return {get(points.front()), 0.0};
-    if (upper == points.end()) return {get(points.back()), 0.0};
-    const Point& a = *(upper - 1);
-    const Point& b = *upper;  // b.x > lo ≥ a.x
-    const double slope = (double(get(b)) - double(get(a))) / (double(b.x) - double(a.x));
-    return {double(get(a)) + slope * (lo - double(a.x)), slope};
-}
-
-}  // namespace
-
 LinearPieces TransferFunction::pieces(float perVoxel) const {
     // Knots: every point's x inside (0, 1), colour and extinction alike; the pieces lie between.
     std::vector<float> knots{0.f};
@@ -562,7 +555,8 @@ void LinearPieces::index() {
     knotsPerBucket = 0;
     for (int b = 0; b < kMax; ++b) {
         const float lo = float(b * kBucketWidth), hi = float((b + 1) * kBucketWidth);
-        firstOfBucket[b] = countKnots(lo);
+        firstOfBucket[b] = 0;  // the knots after the first at or below lo
+        for (int k = 1; k < count; ++k) firstOfBucket[b] += lo >= knot[k];
         int inside = 0;
         for (int k = 1; k < count; ++k) inside += knot[k] > lo && knot[k] < hi;
         knotsPerBucket = std::max(knotsPerBucket, inside);

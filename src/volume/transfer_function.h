@@ -48,12 +48,6 @@ struct LinearPieces {
         while (x >= next[j]) ++j;  // next[count − 1] = +∞
         return j;
     }
-    /// piece() by counting every knot (index() builds the buckets with it).
-    int countKnots(float x) const {
-        int j = 0;
-        for (int k = 1; k < count; ++k) j += x >= knot[k];
-        return j;
-    }
     /// The function at index @p x, in the float operations the vector form repeats.
     Classified operator()(float x) const {
         const int j = piece(x);
@@ -66,8 +60,13 @@ struct LinearPieces {
     bool valid() const;
     /// Fills next, firstOfBucket and knotsPerBucket from count and knot.
     void index();
-    /// True where piece @p j has σ > 0 anywhere (σ ≥ 0 at its knot, so its value or slope is).
-    bool opaque(int j) const { return value[3][j] > 0.f || slope[3][j] > 0.f; }
+    /// The first piece with σ > 0 somewhere (σ ≥ 0 at its knot, so its value or slope is); count
+    /// when none.
+    int firstOpaque() const {
+        int j = 0;
+        while (j < count && !(value[3][j] > 0.f || slope[3][j] > 0.f)) ++j;
+        return j;
+    }
 };
 
 /// @brief A baked transfer function: a dense table over the normalised value, and, where the
