@@ -55,9 +55,15 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
         const V laneRow = hn::ConvertTo(d, hn::ShiftRight<3>(lane));
         for (int cx = 0; cx < cells; ++cx)
             for (int cy = 0; cy < cells; ++cy) {
-                V S = zero, Sx = zero, Sy = zero, Sz = zero, Sxx = zero, Syy = zero, Szz = zero, Sxy = zero,
-                  Sxz = zero, Syz = zero, Er = zero, Eg = zero, Eb = zero, count = zero;
-                for (int x = cx * side; x < (cx + 1) * side; ++x)
+                // Lane by lane (each lane one z): the sums over the cell's voxels in that lane. The
+                // z offset is the lane's own, so the sums with a factor dz are the lane's sums times
+                // dz, taken at the fold (Sz = S·dz, Szz = S·dz², Sxz = Sx·dz, Syz = Sy·dz); and dx is
+                // one per plane x, so a plane's sums P, Py, Pyy take it once per plane (Sx += dx·P,
+                // Sxx += dx²·P, Sxy += dx·Py): 10 operations a vector instead of 21.
+                V S = zero, Sx = zero, Sy = zero, Sxx = zero, Syy = zero, Sxy = zero, Er = zero, Eg = zero, Eb = zero,
+                  count = zero;
+                for (int x = cx * side; x < (cx + 1) * side; ++x) {
+                    V P = zero, Py = zero, Pyy = zero;
                     for (int y = cy * side; y < (cy + 1) * side; y += rowsPerVector) {
                         const int n = x * 64 + y * 8;
                         const V value = hn::LoadU(d, values + n);
@@ -73,14 +79,15 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
                         Er = hn::MulAdd(sigma, red, Er);
                         Eg = hn::MulAdd(sigma, green, Eg);
                         Eb = hn::MulAdd(sigma, blue, Eb);
-                        const V dx = hn::Set(d, float(x & (side - 1)) - half);
                         const V dy = hn::Add(hn::Set(d, float(y & (side - 1)) - half), laneRow);
-                        const V sx = hn::Mul(sigma, dx), sy = hn::Mul(sigma, dy), sz = hn::Mul(sigma, dz);
-                        S = hn::Add(S, sigma);
-                        Sx = hn::Add(Sx, sx), Sy = hn::Add(Sy, sy), Sz = hn::Add(Sz, sz);
-                        Sxx = hn::MulAdd(sx, dx, Sxx), Syy = hn::MulAdd(sy, dy, Syy), Szz = hn::MulAdd(sz, dz, Szz);
-                        Sxy = hn::MulAdd(sx, dy, Sxy), Sxz = hn::MulAdd(sx, dz, Sxz), Syz = hn::MulAdd(sy, dz, Syz);
+                        const V sy = hn::Mul(sigma, dy);
+                        P = hn::Add(P, sigma), Py = hn::Add(Py, sy), Pyy = hn::MulAdd(sy, dy, Pyy);
                     }
+                    const V dx = hn::Set(d, float(x & (side - 1)) - half);
+                    S = hn::Add(S, P), Sx = hn::MulAdd(P, dx, Sx), Sxx = hn::MulAdd(hn::Mul(P, dx), dx, Sxx);
+                    Sy = hn::Add(Sy, Py), Syy = hn::Add(Syy, Pyy), Sxy = hn::MulAdd(Py, dx, Sxy);
+                }
+                const V Sz = hn::Mul(S, dz), Szz = hn::Mul(Sz, dz), Sxz = hn::Mul(Sx, dz), Syz = hn::Mul(Sy, dz);
                 // Each cell along z is the lanes whose z lies in it: fold the rows a vector holds onto
                 // one row of 8 lanes (z), then add the `side` neighbouring lanes of each cell, so that
                 // cell cz's sum lands in lane cz·side (a few shuffles per sum, where a masked
