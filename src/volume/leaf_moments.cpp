@@ -59,7 +59,7 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
                 // z offset is the lane's own, so the sums with a factor dz are the lane's sums times
                 // dz, taken at the fold (Sz = S·dz, Szz = S·dz², Sxz = Sx·dz, Syz = Sy·dz); and dx is
                 // one per plane x, so a plane's sums P, Py, Pyy take it once per plane (Sx += dx·P,
-                // Sxx += dx²·P, Sxy += dx·Py): 10 operations a vector instead of 21.
+                // Sxx += dx²·P, Sxy += dx·Py): 11 operations a vector instead of 20, and 6 a plane.
                 V S = zero, Sx = zero, Sy = zero, Sxx = zero, Syy = zero, Sxy = zero, Er = zero, Eg = zero, Eb = zero,
                   count = zero;
                 for (int x = cx * side; x < (cx + 1) * side; ++x) {
