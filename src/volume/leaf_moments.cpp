@@ -59,7 +59,7 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
                 // z offset is the lane's own, so the sums with a factor dz are the lane's sums times
                 // dz, taken at the fold (Sz = S·dz, Szz = S·dz², Sxz = Sx·dz, Syz = Sy·dz); and dx is
                 // one per plane x, so a plane's sums P, Py, Pyy take it once per plane (Sx += dx·P,
-                // Sxx += dx²·P, Sxy += dx·Py): 11 operations a vector instead of 20, and 6 a plane.
+                // Sxx += dx²·P, Sxy += dx·Py): 11 operations a vector instead of 20, and 5 a plane.
                 V S = zero, Sx = zero, Sy = zero, Sxx = zero, Syy = zero, Sxy = zero, Er = zero, Eg = zero, Eb = zero,
                   count = zero;
                 for (int x = cx * side; x < (cx + 1) * side; ++x) {
@@ -83,8 +83,9 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
                         const V sy = hn::Mul(sigma, dy);
                         P = hn::Add(P, sigma), Py = hn::Add(Py, sy), Pyy = hn::MulAdd(sy, dy, Pyy);
                     }
-                    const V dx = hn::Set(d, float(x & (side - 1)) - half);
-                    S = hn::Add(S, P), Sx = hn::MulAdd(P, dx, Sx), Sxx = hn::MulAdd(hn::Mul(P, dx), dx, Sxx);
+                    const float ox = float(x & (side - 1)) - half;  // dx² = ox² exactly (ox a half-integer ≤ 3.5)
+                    const V dx = hn::Set(d, ox);
+                    S = hn::Add(S, P), Sx = hn::MulAdd(P, dx, Sx), Sxx = hn::MulAdd(P, hn::Set(d, ox * ox), Sxx);
                     Sy = hn::Add(Sy, Py), Syy = hn::Add(Syy, Pyy), Sxy = hn::MulAdd(Py, dx, Sxy);
                 }
                 const V Sz = hn::Mul(S, dz), Szz = hn::Mul(Sz, dz), Sxz = hn::Mul(Sx, dz), Syz = hn::Mul(Sy, dz);
