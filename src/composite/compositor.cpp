@@ -614,7 +614,7 @@ void TileCompositor::drawSplatTables(const TileRecord& p, const ExactIndexMap& m
             const float dx = float(x) + 0.5f - p.centre.x;
             const float i2 = qxx * dx * dx + 2.f * qxy * dx * dy + qyy * dy * dy;
             if (!(i2 < 1.f)) continue;
-            const float tau = exactIndex ? shader.depositAtD2(map.d2(dx, dy)) : shader.depositAtIndex2(i2);
+            const float tau = exactIndex ? shader.depositAtD2(map.d2(i2, dx, dy)) : shader.depositAtIndex2(i2);
             depositAt(px, i, tau, p.color, slabs);
         }
     }

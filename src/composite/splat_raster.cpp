@@ -23,20 +23,19 @@ namespace hn = hwy::HWY_NAMESPACE;
 constexpr int kStride = kTileSize;  // tile row stride
 constexpr int kPairLanes = 16;  // DrawRowPairs: two rows of 8 pixels per vector (16-lane targets)
 
-/// The exact d² = |w|² / |v|² / r², w = c × v, at pixel offsets (dx, dy) from the centre
-/// (DESIGN §3; ExactIndexMap::d2).
+/// The exact d² = 1 − (1 − i²)/w from the affine index i² and the map's w at the same pixel
+/// (ExactIndexMap::d2), clamped at 0.
 template <class D, class V = hn::Vec<D>>
-HWY_INLINE V ExactT(D d, const SplatRaster& s, V dx, V dy) {
-    const auto affine = [&](const glm::vec3& base, const glm::vec3& perY, const glm::vec3& perX, int c) {
-        return hn::MulAdd(dx, hn::Set(d, perX[c]), hn::MulAdd(dy, hn::Set(d, perY[c]), hn::Set(d, base[c])));
-    };
-    const V wx = affine(s.map.A, s.map.C, s.map.B, 0), wy = affine(s.map.A, s.map.C, s.map.B, 1),
-            wz = affine(s.map.A, s.map.C, s.map.B, 2);
-    const V vx = affine(s.map.v0, s.map.vy, s.map.vx, 0), vy = affine(s.map.v0, s.map.vy, s.map.vx, 1),
-            vz = affine(s.map.v0, s.map.vy, s.map.vx, 2);
-    const V w2 = hn::MulAdd(wx, wx, hn::MulAdd(wy, wy, hn::Mul(wz, wz)));
-    const V v2 = hn::MulAdd(vx, vx, hn::MulAdd(vy, vy, hn::Mul(vz, vz)));
-    return hn::Mul(hn::Div(w2, v2), hn::Set(d, s.map.invR2));
+HWY_INLINE V ExactFromIndex(D d, V i2, V w) {
+    const V one = hn::Set(d, 1.f);
+    return hn::Max(hn::Sub(one, hn::Div(hn::Sub(one, i2), w)), hn::Zero(d));
+}
+
+/// The map's w at pixel offsets (dx, dy) from the centre: w0 + dx·(wx + wxx·dx) + dy·(wy + wxy·dx + wyy·dy).
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V MapW(D d, const ExactIndexMap& m, V dx, V dy) {
+    const V xPart = hn::MulAdd(dx, hn::MulAdd(hn::Set(d, m.wxx), dx, hn::Set(d, m.wx)), hn::Set(d, m.w0));
+    return hn::MulAdd(dy, hn::MulAdd(hn::Set(d, m.wyy), dy, hn::MulAdd(hn::Set(d, m.wxy), dx, hn::Set(d, m.wy))), xPart);
 }
 
 /// τ of the splat at index t (i², or the exact d²; the lanes of @p mask are those with t < 1):
@@ -54,16 +53,12 @@ HWY_INLINE V TauAt(D d, const SplatRaster& s, V t) {
     return hn::Max(hn::Mul(hn::Mul(hn::Set(d, s.scale), hn::Sqrt(hn::Sub(one, t))), p), zero);
 }
 
-/// τ of the splat at pixel offsets (dx, dy) from its centre, for the lanes of @p mask (which
-/// the exact index narrows to d² < 1).
-template <class D, class V = hn::Vec<D>, class M = hn::Mask<D>>
-HWY_INLINE V Tau(D d, const SplatRaster& s, V dx, V dy, V i2, M& mask) {
-    V t = i2;
-    if (s.exactIndex) {
-        t = ExactT(d, s, dx, dy);
-        mask = hn::And(mask, hn::Lt(t, hn::Set(d, 1.f)));
-    }
-    return TauAt(d, s, t);
+/// τ of the splat at index @p i2 (the lanes inside its ellipse, i² < 1): at t = i², or, for the
+/// exact index, at d² from i² and the map's w at the same pixels (@p w(), called only then). In
+/// the ellipse d² < 1 up to rounding, where TauAt's t ≤ 1 gives τ = 0: no narrower mask.
+template <class D, class WFn, class V = hn::Vec<D>>
+HWY_INLINE V Tau(D d, const SplatRaster& s, V i2, const WFn& w) {
+    return TauAt(d, s, s.exactIndex ? ExactFromIndex(d, i2, w()) : i2);
 }
 
 /// 1 − e^{−τ} ≈ τ·Σ_{k<K} (−τ)^k/(k + 1)!, the Taylor series to τ^K (Horner: K − 1 FMAs and a product).
@@ -140,15 +135,15 @@ HWY_INLINE V IndexSquared(D d, const SplatRaster& s, V dx, V dy) {
 /// What DrawRowsWide needs of each of a splat's rows in a tile (index k: row y0 + k), set up a
 /// vector of rows at a time: the row's chord [xa, xb] in tile columns (xa > xb: none) and, with
 /// dx the pixel centre's x − cx, the row's quadratics in dx:
-///     i²  = i0 + dx·(i1 + Qxx·dx)                    (i0 = Qyy dy², i1 = 2 Qxy dy)
-///     |w|² = w0 + dx·(w1 + |B|²·dx), |v|² = v0 + dx·(v1 + |v_x|²·dx)   (exact index, row part
-///           W = A + C·dy: w0 = |W|², w1 = 2 W·B; likewise v from v0, v_y, v_x; DESIGN §3)
-/// so that a vector of pixels costs two FMAs per quadratic instead of the affine maps' eighteen.
+///     i² = i0 + dx·(i1 + Qxx·dx)     (i0 = Qyy dy², i1 = 2 Qxy dy)
+///     w  = w0 + dx·(w1 + wxx·dx)     (exact index: w0 = map.w0 + dy·(map.wy + wyy·dy),
+///                                     w1 = map.wx + wxy·dy; ExactIndexMap)
+/// so that a vector of pixels costs two FMAs per quadratic.
 struct RowQuadratics {
     static constexpr int kMax = kTileSize + 16;  ///< rows of a tile, and a last vector's spill
     alignas(64) int32_t xa[kMax], xb[kMax];
     alignas(64) float i0[kMax], i1[kMax];
-    alignas(64) float w0[kMax], w1[kMax], v0[kMax], v1[kMax];
+    alignas(64) float w0[kMax], w1[kMax];
 };
 
 /// Every row's chord of the support ellipse i² < 1, one reciprocal for its two roots (as
@@ -180,18 +175,8 @@ HWY_INLINE void SetUpRows(D d, const SplatRaster& s, const TileBuffers& tile, Ro
         hn::StoreU(hn::Mul(hn::Mul(hn::Set(d, s.qyy), dy), dy), d, q.i0 + k);
         hn::StoreU(hn::Mul(hn::Set(d, 2.f * s.qxy), dy), d, q.i1 + k);
         if (!s.exactIndex) continue;
-        const auto quadratic = [&](const glm::vec3& c0, const glm::vec3& perY, const glm::vec3& perX, float* q0, float* q1) {
-            V sq = zero, lin = zero;
-            for (int c = 0; c < 3; ++c) {
-                const V w = hn::MulAdd(dy, hn::Set(d, perY[c]), hn::Set(d, c0[c]));  // the row's W
-                sq = hn::MulAdd(w, w, sq);
-                lin = hn::MulAdd(w, hn::Set(d, 2.f * perX[c]), lin);
-            }
-            hn::StoreU(sq, d, q0 + k);
-            hn::StoreU(lin, d, q1 + k);
-        };
-        quadratic(s.map.A, s.map.C, s.map.B, q.w0, q.w1);
-        quadratic(s.map.v0, s.map.vy, s.map.vx, q.v0, q.v1);
+        hn::StoreU(hn::MulAdd(dy, hn::MulAdd(hn::Set(d, s.map.wyy), dy, hn::Set(d, s.map.wy)), hn::Set(d, s.map.w0)), d, q.w0 + k);
+        hn::StoreU(hn::MulAdd(hn::Set(d, s.map.wxy), dy, hn::Set(d, s.map.wx)), d, q.w1 + k);
     }
 }
 
@@ -209,8 +194,7 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
     SetUpRows(d, s, tile, q);
     const V lane = hn::Iota(d, 0.5f);  // pixel centre offsets 0.5, 1.5, …
     const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon), qxx = hn::Set(d, s.qxx);
-    const V wxx = hn::Set(d, glm::dot(s.map.B, s.map.B)), vxx = hn::Set(d, glm::dot(s.map.vx, s.map.vx));
-    const V invR2 = hn::Set(d, s.map.invR2);
+    const V wxx = hn::Set(d, s.map.wxx);
     const V cx = hn::Set(d, s.cx);
     const V rgb[3] = {hn::Set(d, s.color.x), hn::Set(d, s.color.y), hn::Set(d, s.color.z)};
     const int rows = s.y1 - s.y0 + 1;
@@ -234,16 +218,10 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
             const V i2 = hn::MulAdd(hn::MulAdd(qxx, dx, i1), dx, i0);
             float* pt = tile.T + row + c;
             const V T = hn::LoadU(d, pt);
-            auto mask = hn::And(chord, hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
+            const auto mask = hn::And(chord, hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
             if (hn::AllFalse(d, mask)) continue;
-            V t = i2;
-            if (s.exactIndex) {
-                const V w2 = hn::MulAdd(hn::MulAdd(wxx, dx, hn::Set(d, q.w1[k])), dx, hn::Set(d, q.w0[k]));
-                const V v2 = hn::MulAdd(hn::MulAdd(vxx, dx, hn::Set(d, q.v1[k])), dx, hn::Set(d, q.v0[k]));
-                t = hn::Mul(hn::Div(w2, v2), invR2);
-                mask = hn::And(mask, hn::Lt(t, one));
-            }
-            Deposit<kSlabs>(d, s, tile, TauAt(d, s, t), T, mask, rgb, [&](const float* base) { return hn::LoadU(d, base + row + c); },
+            const V tau = Tau(d, s, i2, [&] { return hn::MulAdd(hn::MulAdd(wxx, dx, hn::Set(d, q.w1[k])), dx, hn::Set(d, q.w0[k])); });
+            Deposit<kSlabs>(d, s, tile, tau, T, mask, rgb, [&](const float* base) { return hn::LoadU(d, base + row + c); },
                             [&](float* base, V v) { hn::StoreU(v, d, base + row + c); });
         }
     }
@@ -289,13 +267,13 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
         const auto load = [&](const float* base) { return hn::Combine(d, hn::LoadU(dh, base + offB), hn::LoadU(dh, base + offA)); };
         const V T = load(tile.T);
         const uint8_t chord[8] = {uint8_t(w.bits[ka]), uint8_t(pair ? w.bits[kb] : 0)};
-        auto mask = hn::And(hn::LoadMaskBits(d, chord), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
+        const auto mask = hn::And(hn::LoadMaskBits(d, chord), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
         if (hn::AllFalse(d, mask)) continue;
         const auto store = [&](float* base, V value) {
             hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
             if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
-        const V tau = Tau(d, s, dx, dy, i2, mask);  // narrows the mask (exact index) before the deposit reads it
+        const V tau = Tau(d, s, i2, [&] { return MapW(d, s.map, dx, dy); });
         Deposit<kSlabs>(d, s, tile, tau, T, mask, rgb, load, store);
     }
 }
@@ -314,6 +292,9 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
     const V xPix = hn::Add(hn::Set(d, float(tile.x0 + start)), hn::Combine(d, hn::Iota(dh, 0.5f), hn::Iota(dh, 0.5f)));
     const V dx = hn::Sub(xPix, hn::Set(d, s.cx));
     const V ixx = hn::Mul(hn::Mul(hn::Set(d, s.qxx), dx), dx), ixy = hn::Mul(hn::Set(d, 2.f * s.qxy), dx);
+    // The exact index's w in the same form (MapW's terms in dx alone, fixed per splat): w = wxPart + dy·(wyy·dy + wxy).
+    const V wxPart = hn::MulAdd(dx, hn::MulAdd(hn::Set(d, s.map.wxx), dx, hn::Set(d, s.map.wx)), hn::Set(d, s.map.w0));
+    const V wxy = hn::MulAdd(hn::Set(d, s.map.wxy), dx, hn::Set(d, s.map.wy)), wyy = hn::Set(d, s.map.wyy);
     const V qyy = hn::Set(d, s.qyy), cy = hn::Set(d, s.cy);
     const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon);
     const V rgb[3] = {hn::Set(d, s.color.x), hn::Set(d, s.color.y), hn::Set(d, s.color.z)};
@@ -329,13 +310,13 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
         const V i2 = hn::MulAdd(hn::MulAdd(qyy, dy, ixy), dy, ixx);
         const auto load = [&](const float* base) { return hn::Combine(d, hn::LoadU(dh, base + offB), hn::LoadU(dh, base + off)); };
         const V T = load(tile.T);
-        auto mask = hn::And(kPair ? columns : hn::And(columns, lowerHalf), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
+        const auto mask = hn::And(kPair ? columns : hn::And(columns, lowerHalf), hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
         if (hn::AllFalse(d, mask)) return;
         const auto store = [&](float* base, V value) {
             hn::StoreU(hn::LowerHalf(dh, value), dh, base + off);
             if constexpr (kPair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
-        const V tau = Tau(d, s, dx, dy, i2, mask);  // narrows the mask (exact index) before the deposit reads it
+        const V tau = Tau(d, s, i2, [&] { return hn::MulAdd(hn::MulAdd(wyy, dy, wxy), dy, wxPart); });
         Deposit<kSlabs>(d, s, tile, tau, T, mask, rgb, load, store);
     };
     V yPix = hn::Add(hn::Set(d, float(s.y0) + 0.5f), hn::Combine(d, hn::Set(dh, 1.f), hn::Zero(dh)));  // rows y, y + 1
@@ -465,10 +446,9 @@ void drawSplatScalarPoly(const SplatRaster& s, const TileBuffers& tile) {
             const float dx = float(x) + 0.5f - s.cx;
             const float i2 = s.qxx * dx * dx + 2.f * s.qxy * dx * dy + s.qyy * dy * dy;
             if (!(i2 < 1.f)) continue;
-            const float t = s.exactIndex ? s.map.d2(dx, dy) : i2;
+            const float t = s.exactIndex ? s.map.d2(i2, dx, dy) : i2;
             const float tau = s.scale * FootprintPolynomials::evaluate(s.coef, t);
             if (s.slabs) {
-                if (s.exactIndex && !(t < 1.f)) continue;  // as the vector loop's mask
                 for (int j = 0; j < s.slabs->count; ++j) {
                     const float tj = tau * s.slabs->fraction[size_t(j)];
                     s.slabs->tau[size_t(j)][i] += tj;

@@ -130,18 +130,15 @@ bool rayHitsEllipsoid(const VoxelShape& shape, const ViewPoint& c, const glm::dv
 ExactIndexMap makeEllipsoidIndexMap(const ScreenKernel& k, const EllipsoidProjection& e, const VoxelShape& shape,
                                     const PixelCoord& origin) {
     const SphereProjection& s = e.ellipse;
-    // The view rays of the pulled-back pixels, affine in δ (as makeExactIndexMap), then into index space.
+    // The view rays of the pulled-back pixels, affine in δ (as makeExactIndexMap), then into
+    // index space, where the kernel is a ball: d² − 1 and i² − 1 are proportional there too
+    // (screen_kernel.h), with κ = |M⁻¹v_c|²·(1 − d²(v_c)) at the ellipse's centre.
     const glm::dvec3 v0 = pixelRay(s, k.centre + k.pullback * (origin - k.centre));
     const glm::dvec3 vx(k.pullback[0].x / s.f, -k.pullback[0].y / s.f, 0.0);
     const glm::dvec3 vy(k.pullback[1].x / s.f, -k.pullback[1].y / s.f, 0.0);
-    const glm::dmat3 toW = glm::transpose(shape.M) / shape.volume;
-    ExactIndexMap m;
-    m.v0 = glm::vec3(shape.N * v0), m.vx = glm::vec3(shape.N * vx), m.vy = glm::vec3(shape.N * vy);
-    m.A = glm::vec3(toW * glm::cross(s.c, v0));
-    m.B = glm::vec3(toW * glm::cross(s.c, vx));
-    m.C = glm::vec3(toW * glm::cross(s.c, vy));
-    m.invR2 = float(1.0 / (kR * kR));
-    return m;
+    const glm::dvec3 vc = pixelRay(s, k.centre), nc = shape.N * vc;
+    const double kappa = glm::dot(nc, nc) * (1.0 - ellipsoidRayDistance2(shape, s.c, vc));
+    return exactIndexMapOf(shape.N * v0, shape.N * vx, shape.N * vy, kappa);
 }
 
 double ellipsoidHalfRayDeposit(const VoxelShape& shape, const ViewPoint& c, const glm::dvec3& v) {

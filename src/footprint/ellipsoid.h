@@ -79,9 +79,9 @@ double ellipsoidRayDistance2(const VoxelShape& shape, const ViewPoint& c, const 
 bool rayHitsEllipsoid(const VoxelShape& shape, const ViewPoint& c, const glm::dvec3& v);
 
 /// @brief The ExactIndexMap of the widened kernel @p k of an ellipsoid projection @p e
-/// (δ from @p origin): the pulled-back pixel's ray carried into index space, v' = M⁻¹v and
-/// w' = Mᵀ(c × v)/|det M|, so that d² = |w'|²/|v'|²/R² — the same map the compositor's
-/// exact-index loop reads for spheres.
+/// (δ from @p origin): the pulled-back pixel's ray carried into index space, v' = M⁻¹v, where
+/// the kernel is a ball, so that d² = 1 − (1 − i²)·κ/|v'|² as for spheres — the same map the
+/// compositor's exact-index loop reads for spheres.
 ExactIndexMap makeEllipsoidIndexMap(const ScreenKernel& k, const EllipsoidProjection& e, const VoxelShape& shape,
                                     const PixelCoord& origin);
 

@@ -59,6 +59,15 @@ double exactIndexD2(const ScreenKernel& k, const SphereProjection& e, const Pixe
     return exactRayDistance2(e, k.centre + k.pullback * (p - k.centre));
 }
 
+ExactIndexMap exactIndexMapOf(const glm::dvec3& u0, const glm::dvec3& ux, const glm::dvec3& uy, double kappa) {
+    const double inv = 1.0 / kappa;
+    ExactIndexMap m;
+    m.w0 = float(glm::dot(u0, u0) * inv);
+    m.wx = float(2.0 * glm::dot(u0, ux) * inv), m.wy = float(2.0 * glm::dot(u0, uy) * inv);
+    m.wxx = float(glm::dot(ux, ux) * inv), m.wxy = float(2.0 * glm::dot(ux, uy) * inv), m.wyy = float(glm::dot(uy, uy) * inv);
+    return m;
+}
+
 ExactIndexMap makeExactIndexMap(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& origin) {
     // p' = k.centre + S·(p − k.centre) = [k.centre + S·(origin − k.centre)] + S·δ, and
     // pixelRay(p') = ((p'.x − pp.x)·(1/f), −(p'.y − pp.y)·(1/f), 1) is affine in p'. The lane
@@ -67,11 +76,10 @@ ExactIndexMap makeExactIndexMap(const ScreenKernel& k, const SphereProjection& e
     const glm::dvec3 v0 = pixelRay(e, k.centre + k.pullback * (origin - k.centre));
     const glm::dvec3 vx(k.pullback[0].x * invF, -k.pullback[0].y * invF, 0.0);  // S·(1, 0) = column 0
     const glm::dvec3 vy(k.pullback[1].x * invF, -k.pullback[1].y * invF, 0.0);
-    ExactIndexMap m;
-    m.v0 = glm::vec3(v0), m.vx = glm::vec3(vx), m.vy = glm::vec3(vy);
-    m.A = glm::vec3(glm::cross(e.c, v0)), m.B = glm::vec3(glm::cross(e.c, vx)), m.C = glm::vec3(glm::cross(e.c, vy));
-    m.invR2 = float(1.0 / (e.r * e.r));
-    return m;
+    // κ = |v_c|²·(1 − d²(v_c)) = |v_c|² − |c × v_c|²/r² at the centre (i² = 0), pulled back to itself.
+    const glm::dvec3 vc = pixelRay(e, k.centre), A = glm::cross(e.c, vc);
+    const double kappa = glm::dot(vc, vc) - glm::dot(A, A) * (1.0 / (e.r * e.r));
+    return exactIndexMapOf(v0, vx, vy, kappa);
 }
 
 double splatDepositExact(const ScreenKernel& k, const SphereProjection& e, double sigma, double h,

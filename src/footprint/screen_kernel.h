@@ -94,23 +94,36 @@ double splatDeposit(const ScreenKernel& k, const SplatShader& shader, const Pixe
 /// of the table path.
 double exactIndexD2(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& p);
 
-/// @brief exactIndexD2 as an affine map of the pixel, for hot loops (--footprint auto).
-/// With δ = p − origin, the ray through the pulled-back pixel is v = v0 + δx·vx + δy·vy
-/// (pixelRay is affine in the pixel, and so is the pullback), hence c × v = A + δx·B + δy·C
-/// and d² = |c × v|² / (|v|²·r²) (DESIGN §3) costs about 20 float operations per pixel.
-/// The six vectors are formed in double; every term is O(α) and none cancels badly, so d
-/// stays within ~1e−6 of exactIndexD2 (ScreenKernel.ExactIndexMapMatchesExactIndexD2).
-/// It does not test the support: callers use the conic (i² < 1) as the table path does.
+/// @brief exactIndexD2 from the affine index, for hot loops (--footprint auto; docs/footprint.md,
+/// "The exact index from the affine one"). The kernel's silhouette is the conic's ellipse, so
+/// with v the ray through the pulled-back pixel, d² − 1 = (|c × v|² − r²|v|²)/(r²|v|²) and i² − 1
+/// are two quadratics of the pixel with the same zero set: proportional. At the ellipse's centre
+/// (i² = 0, ray v_c) the factor is κ = |v_c|²·(1 − d²(v_c)), so
+///     d² = 1 − (1 − i²) / w(δ),   w(δ) = |v(δ)|² / κ,
+/// and, v being affine in δ = pixel − origin (pixelRay and the pullback are), w is a quadratic
+/// in δ: six numbers per splat instead of the 19 of the ray and c × v, and per pixel two FMAs
+/// (a row's part set up once), a division and two subtractions on top of the i² the loop has.
+/// An ellipsoid's kernel is a ball in index space: v there is M⁻¹v (makeEllipsoidIndexMap).
+/// w is formed in double and rounded to float; with the float i² of the compositor's conic,
+/// d² stays within ~2e−7 of exactIndexD2 (ScreenKernel.ExactIndexMapMatchesExactIndexD2).
+/// It does not test the support: callers use the conic (i² < 1, which gives d² < 1) as the
+/// table path does.
 struct ExactIndexMap {
-    glm::vec3 v0{0.f}, vx{0.f}, vy{0.f};  ///< ray of the pulled-back pixel: v0 + δx·vx + δy·vy
-    glm::vec3 A{0.f}, B{0.f}, C{0.f};     ///< c × v0, c × vx, c × vy
-    float invR2 = 0.f;                    ///< 1 / r²
+    float w0 = 0.f, wx = 0.f, wy = 0.f;     ///< w(δ) = w0 + wx·δx + wy·δy
+    float wxx = 0.f, wxy = 0.f, wyy = 0.f;  ///<        + wxx·δx² + wxy·δx·δy + wyy·δy²
 
-    float d2(float dx, float dy) const {
-        const glm::vec3 w = A + dx * B + dy * C, v = v0 + dx * vx + dy * vy;
-        return glm::dot(w, w) / (glm::dot(v, v)) * invR2;
-    }
+    float w(float dx, float dy) const { return w0 + dx * (wx + wxx * dx) + dy * (wy + wxy * dx + wyy * dy); }
+    /// d² at offsets (@p dx, @p dy) from the origin, where the conic's index is @p i2 (clamped at
+    /// 0: near the centre ray the difference of two numbers close to 1 can round below it).
+    float d2(float i2, float dx, float dy) const { return std::max(0.f, 1.f - (1.f - i2) / w(dx, dy)); }
+    bool operator==(const ExactIndexMap&) const = default;
 };
+
+/// @brief The ExactIndexMap of the rays u(δ) = @p u0 + δx·@p ux + δy·@p uy through the pulled-back
+/// pixels, in the space where the kernel is a ball, and @p kappa = κ (see ExactIndexMap): the
+/// coefficients of |u(δ)|²/κ, each dot product (glm's order) times 1/κ (the lane projection
+/// mirrors these operations).
+ExactIndexMap exactIndexMapOf(const glm::dvec3& u0, const glm::dvec3& ux, const glm::dvec3& uy, double kappa);
 
 /// @brief The ExactIndexMap of kernel @p k of Ellipse @p e, with δ measured from @p origin.
 ExactIndexMap makeExactIndexMap(const ScreenKernel& k, const SphereProjection& e, const PixelCoord& origin);

@@ -41,7 +41,7 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
     const hn::ScalableTag<double> d;
     using V = hn::Vec<decltype(d)>;
     const size_t N = hn::Lanes(d);
-    const V zero = hn::Zero(d), one = hn::Set(d, 1.0), half = hn::Set(d, 0.5);
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
     const V f = hn::Set(d, ctx.focal), px = hn::Set(d, ctx.principalX), py = hn::Set(d, ctx.principalY);
     const V r = hn::Set(d, ctx.radius), r2 = hn::Set(d, ctx.radius * ctx.radius), fr = hn::Set(d, ctx.focal * ctx.radius);
     const V widen = hn::Set(d, ctx.widen), hf = hn::Set(d, ctx.spacingTimesFocal), threshold = hn::Set(d, ctx.threshold);
@@ -117,21 +117,26 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         if (hn::AllFalse(d, hn::And(handled, exact))) continue;
         // makeExactIndexMap from the kernel's centre (makeSplat): p' = centre, v0 = ((cx − px)·(1/f),
         // −(cy − py)·(1/f), 1), vx = (P00·(1/f), −P01·(1/f), 0), vy = (P10·(1/f), −P11·(1/f), 0);
-        // A = c × v0, B = c × vx, C = c × vy (glm::cross).
-        const V pxp = cx, pyp = cy;
-        const V v0x = hn::Mul(hn::Sub(pxp, px), invF), v0y = hn::Mul(hn::Neg(hn::Sub(pyp, py)), invF), v0z = one;
-        const V vxx = hn::Mul(p00, invF), vxy = hn::Mul(hn::Neg(p01), invF), vxz = zero;
-        const V vyx = hn::Mul(p01, invF), vyy = hn::Mul(hn::Neg(p11), invF), vyz = zero;
-        const auto cross = [&](V wx, V wy, V wz, V out[3]) {
-            out[0] = hn::Sub(hn::Mul(y, wz), hn::Mul(wy, z));
-            out[1] = hn::Sub(hn::Mul(z, wx), hn::Mul(wz, x));
-            out[2] = hn::Sub(hn::Mul(x, wy), hn::Mul(wx, y));
-        };
-        V A[3], B[3], C[3];
-        cross(v0x, v0y, v0z, A), cross(vxx, vxy, vxz, B), cross(vyx, vyy, vyz, C);
-        const V all[19] = {v0x, v0y, v0z, vxx, vxy, vxz, vyx, vyy, vyz, A[0], A[1], A[2],
-                           B[0], B[1], B[2], C[0], C[1], C[2], invR2};
-        for (int k = 0; k < 19; ++k) hn::Store(all[k], d, L.map[k] + i);
+        // v_c = v0, A = c × v0 (glm::cross), κ = v0·v0 − (A·A)·(1/r²); then exactIndexMapOf: each
+        // coefficient a dot product (glm: (x·x' + y·y') + z·z', the z parts 1 or 0) times 1/κ.
+        const V v0x = hn::Mul(hn::Sub(cx, px), invF), v0y = hn::Mul(hn::Neg(hn::Sub(cy, py)), invF);
+        const V vxx = hn::Mul(p00, invF), vxy = hn::Mul(hn::Neg(p01), invF);
+        const V vyx = hn::Mul(p01, invF), vyy = hn::Mul(hn::Neg(p11), invF);
+        const V Ax = hn::Sub(hn::Mul(y, one), hn::Mul(v0y, z));
+        const V Ay = hn::Sub(hn::Mul(z, v0x), hn::Mul(one, x));
+        const V Az = hn::Sub(hn::Mul(x, v0y), hn::Mul(v0x, y));
+        const auto dot2 = [](V ax, V ay, V bx, V by) { return hn::Add(hn::Mul(ax, bx), hn::Mul(ay, by)); };
+        const V v0v0 = hn::Add(dot2(v0x, v0y, v0x, v0y), one);
+        const V AA = hn::Add(dot2(Ax, Ay, Ax, Ay), hn::Mul(Az, Az));
+        const V inv = hn::Div(one, hn::Sub(v0v0, hn::Mul(AA, invR2)));
+        const V two = hn::Set(d, 2.0);
+        const V all[6] = {hn::Mul(v0v0, inv),
+                          hn::Mul(hn::Mul(two, dot2(v0x, v0y, vxx, vxy)), inv),
+                          hn::Mul(hn::Mul(two, dot2(v0x, v0y, vyx, vyy)), inv),
+                          hn::Mul(dot2(vxx, vxy, vxx, vxy), inv),
+                          hn::Mul(hn::Mul(two, dot2(vxx, vxy, vyx, vyy)), inv),
+                          hn::Mul(dot2(vyx, vyy, vyx, vyy), inv)};
+        for (int k = 0; k < 6; ++k) hn::Store(all[k], d, L.map[k] + i);
     }
 }
 
@@ -319,10 +324,8 @@ void projectSplatsVector(SplatLanes& lanes, size_t n, const SplatLaneContext& ct
 }
 
 void SplatLanes::exactMapInto(size_t i, ExactIndexMap& m) const {
-    const auto v3 = [&](int k) { return glm::vec3(float(map[k][i]), float(map[k + 1][i]), float(map[k + 2][i])); };
-    m.v0 = v3(0), m.vx = v3(3), m.vy = v3(6);
-    m.A = v3(9), m.B = v3(12), m.C = v3(15);
-    m.invR2 = float(map[18][i]);
+    m.w0 = float(map[0][i]), m.wx = float(map[1][i]), m.wy = float(map[2][i]);
+    m.wxx = float(map[3][i]), m.wxy = float(map[4][i]), m.wyy = float(map[5][i]);
 }
 
 }  // namespace vdbsplat

@@ -48,8 +48,8 @@ struct SplatLanes {
     alignas(64) double conicXX[kSplatLanes], conicXY[kSplatLanes], conicYY[kSplatLanes];
     alignas(64) double sinAlpha[kSplatLanes];
     alignas(64) double x0[kSplatLanes], y0[kSplatLanes], x1[kSplatLanes], y1[kSplatLanes];  ///< integers
-    /// kExactIndex: the map's 19 values (v0, vx, vy, A, B, C as xyz, then 1/r²), lane by lane.
-    alignas(64) double map[19][kSplatLanes];
+    /// kExactIndex: the map's 6 values (w0, wx, wy, wxx, wxy, wyy; ExactIndexMap), lane by lane.
+    alignas(64) double map[6][kSplatLanes];
     uint8_t status[kSplatLanes];
 
     PixelRange range(size_t i) const { return {int(x0[i]), int(y0[i]), int(x1[i]), int(y1[i])}; }

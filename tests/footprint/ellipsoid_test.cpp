@@ -124,7 +124,8 @@ TEST(Ellipsoid, IndexMapMatchesTheExactDistance) {
                 for (double dx = -k.a; dx <= k.a; dx += k.a / 7) {
                     const double want = ellipsoidRayDistance2(shape, c, ray(origin + PixelCoord(dx, dy)));
                     if (want > 1.0) continue;
-                    EXPECT_NEAR(map.d2(float(dx), float(dy)), want, 2e-5);
+                    const float i2 = float(k.index2(origin + PixelCoord(dx, dy)));
+                    EXPECT_NEAR(map.d2(i2, float(dx), float(dy)), want, 2e-5);
                 }
         }
     }
