@@ -38,10 +38,10 @@ HWY_INLINE V MapW(D d, const ExactIndexMap& m, V dx, V dy) {
     return hn::MulAdd(dy, hn::MulAdd(hn::Set(d, m.wyy), dy, hn::MulAdd(hn::Set(d, m.wxy), dx, hn::Set(d, m.wy))), xPart);
 }
 
-/// τ of the splat at index t (i², or the exact d²; the lanes of @p mask are those with t < 1):
-/// τ = scale·√(1 − t)·G(2t − 1) (Horner, footprint_poly.h). t ≥ 0 but for rounding (a few ulps
-/// below 0 at the centre, where the polynomial is as good), so only t ≤ 1 is enforced: the
-/// lanes outside the ellipse then stay finite, and the opacity's test per vector sees no NaN.
+/// τ of the splat at index t (i², or the exact d²): τ = scale·√(1 − t)·G(2t − 1) (Horner,
+/// footprint_poly.h). i² ≥ 0 but for rounding (a few ulps below 0 at the centre, where the
+/// polynomial is as good; the exact d² is clamped at 0), so only t ≤ 1 is enforced: the lanes
+/// outside the ellipse then stay finite, and the opacity's test per vector sees no NaN.
 template <class D, class V = hn::Vec<D>>
 HWY_INLINE V TauAt(D d, const SplatRaster& s, V t) {
     const V zero = hn::Zero(d), one = hn::Set(d, 1.f), two = hn::Set(d, 2.f);

@@ -122,8 +122,8 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         const V v0x = hn::Mul(hn::Sub(cx, px), invF), v0y = hn::Mul(hn::Neg(hn::Sub(cy, py)), invF);
         const V vxx = hn::Mul(p00, invF), vxy = hn::Mul(hn::Neg(p01), invF);
         const V vyx = hn::Mul(p01, invF), vyy = hn::Mul(hn::Neg(p11), invF);
-        const V Ax = hn::Sub(hn::Mul(y, one), hn::Mul(v0y, z));
-        const V Ay = hn::Sub(hn::Mul(z, v0x), hn::Mul(one, x));
+        const V Ax = hn::Sub(y, hn::Mul(v0y, z));  // glm::cross(c, v0) with v0.z = 1 (y·1 = y exactly)
+        const V Ay = hn::Sub(hn::Mul(z, v0x), x);
         const V Az = hn::Sub(hn::Mul(x, v0y), hn::Mul(v0x, y));
         const auto dot2 = [](V ax, V ay, V bx, V by) { return hn::Add(hn::Mul(ax, bx), hn::Mul(ay, by)); };
         const V v0v0 = hn::Add(dot2(v0x, v0y, v0x, v0y), one);
