@@ -31,11 +31,20 @@ HWY_INLINE V ExactFromIndex(D d, V i2, V w) {
     return hn::Max(hn::Sub(one, hn::Div(hn::Sub(one, i2), w)), hn::Zero(d));
 }
 
-/// The map's w at pixel offsets (dx, dy) from the centre: w0 + dx·(wx + wxx·dx) + dy·(wy + wxy·dx + wyy·dy).
+/// The map's w = w0 + dx·(wx + wxx·dx) + dy·(wy + wxy·dx + wyy·dy) at pixel offsets (dx, dy) from
+/// the centre, in two parts that depend on dx alone (a loop whose dx is fixed sets them up once):
+/// WAlongX = w0 + dx·(wx + wxx·dx), WCross = wy + wxy·dx, and w = WAlongX + dy·(wyy·dy + WCross).
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V WAlongX(D d, const ExactIndexMap& m, V dx) {
+    return hn::MulAdd(dx, hn::MulAdd(hn::Set(d, m.wxx), dx, hn::Set(d, m.wx)), hn::Set(d, m.w0));
+}
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V WCross(D d, const ExactIndexMap& m, V dx) {
+    return hn::MulAdd(hn::Set(d, m.wxy), dx, hn::Set(d, m.wy));
+}
 template <class D, class V = hn::Vec<D>>
 HWY_INLINE V MapW(D d, const ExactIndexMap& m, V dx, V dy) {
-    const V xPart = hn::MulAdd(dx, hn::MulAdd(hn::Set(d, m.wxx), dx, hn::Set(d, m.wx)), hn::Set(d, m.w0));
-    return hn::MulAdd(dy, hn::MulAdd(hn::Set(d, m.wyy), dy, hn::MulAdd(hn::Set(d, m.wxy), dx, hn::Set(d, m.wy))), xPart);
+    return hn::MulAdd(hn::MulAdd(hn::Set(d, m.wyy), dy, WCross(d, m, dx)), dy, WAlongX(d, m, dx));
 }
 
 /// τ of the splat at index t (i², or the exact d²): τ = scale·√(1 − t)·G(2t − 1) (Horner,
@@ -292,9 +301,10 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
     const V xPix = hn::Add(hn::Set(d, float(tile.x0 + start)), hn::Combine(d, hn::Iota(dh, 0.5f), hn::Iota(dh, 0.5f)));
     const V dx = hn::Sub(xPix, hn::Set(d, s.cx));
     const V ixx = hn::Mul(hn::Mul(hn::Set(d, s.qxx), dx), dx), ixy = hn::Mul(hn::Set(d, 2.f * s.qxy), dx);
-    // The exact index's w in the same form (MapW's terms in dx alone, fixed per splat): w = wxPart + dy·(wyy·dy + wxy).
-    const V wxPart = hn::MulAdd(dx, hn::MulAdd(hn::Set(d, s.map.wxx), dx, hn::Set(d, s.map.wx)), hn::Set(d, s.map.w0));
-    const V wxy = hn::MulAdd(hn::Set(d, s.map.wxy), dx, hn::Set(d, s.map.wy)), wyy = hn::Set(d, s.map.wyy);
+    // The exact index's w in the same form (MapW's parts in dx alone, fixed per splat), set up
+    // only for the splats that read it.
+    V wAlongX = hn::Zero(d), wCross = wAlongX, wyy = wAlongX;
+    if (s.exactIndex) wAlongX = WAlongX(d, s.map, dx), wCross = WCross(d, s.map, dx), wyy = hn::Set(d, s.map.wyy);
     const V qyy = hn::Set(d, s.qyy), cy = hn::Set(d, s.cy);
     const V one = hn::Set(d, 1.f), eps = hn::Set(d, s.epsilon);
     const V rgb[3] = {hn::Set(d, s.color.x), hn::Set(d, s.color.y), hn::Set(d, s.color.z)};
@@ -316,7 +326,7 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
             hn::StoreU(hn::LowerHalf(dh, value), dh, base + off);
             if constexpr (kPair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
-        const V tau = Tau(d, s, i2, [&] { return hn::MulAdd(hn::MulAdd(wyy, dy, wxy), dy, wxPart); });
+        const V tau = Tau(d, s, i2, [&] { return hn::MulAdd(hn::MulAdd(wyy, dy, wCross), dy, wAlongX); });
         Deposit<kSlabs>(d, s, tile, tau, T, mask, rgb, load, store);
     };
     V yPix = hn::Add(hn::Set(d, float(s.y0) + 0.5f), hn::Combine(d, hn::Set(dh, 1.f), hn::Zero(dh)));  // rows y, y + 1
