@@ -46,8 +46,9 @@ struct ExactContext {
     /// Splats through the vector loop (composite/splat_raster.h, polynomial footprint); false:
     /// the scalar table path, the oracle it is tested against.
     bool vector = true;
-    /// The low-pass folded into kernels recomputed per tile (px²; as ProjectionContext).
-    double prefilterVariance = kPrefilterVariance;
+    /// The low-pass folded into kernels recomputed per tile, by their projected spacing (px²; as
+    /// ProjectionContext::lowPass).
+    PrefilterRamp lowPass;
     /// The kernels' shape in view space (footprint/ellipsoid.h); null or a sphere: spheres.
     /// Ellipsoid kernels at the eye (NearEye) take the exact index-space half-ray integral.
     const VoxelShape* shape = nullptr;

@@ -50,9 +50,12 @@ struct ScreenKernel {
 
 /// @brief What the low-pass of variance @p prefilterVariance (px²) adds to the squares of the
 /// kernel's support semi-axes: (R/s_g)²·max(V, 0), so a' = √(a² + w) (makeScreenKernel).
-inline double supportWidening(const KernelShape& kernel, double prefilterVariance) {
+inline double supportWideningPerVariance(const KernelShape& kernel) {
     const double toSupport = kernel.radius() / kernel.sigma();  // std → support semi-axis
-    return toSupport * toSupport * std::max(prefilterVariance, 0.0);
+    return toSupport * toSupport;
+}
+inline double supportWidening(const KernelShape& kernel, double prefilterVariance) {
+    return supportWideningPerVariance(kernel) * std::max(prefilterVariance, 0.0);
 }
 
 /// @brief The EWA screen kernel of the Ellipse @p e with low-pass variance

@@ -32,7 +32,8 @@ constexpr double kMaxPointSpacingSubpx = 2.0;
 struct ForwardPass {
     double threshold;          ///< τ (px): projected voxel spacing below which voxels are points
     double lodPx;              ///< level-of-detail cell size (px)
-    double prefilterVariance;  ///< V_h folded into each primitive (px²)
+    double prefilterVariance;  ///< V_h folded into each minified primitive (px²)
+    double magnifiedPrefilterVariance;  ///< and into magnified ones (the ramp's end; footprint/prefilter.h)
     /// The low-pass the level-of-detail rule weighs an aggregate's spread against (px²; volume/stream.h):
     /// prefilterVariance, except on a grid of k sub-pixels, where it is V_s·k. With V_s alone the
     /// grid draws far finer aggregates than the pixel grid (16× the points at the far checker box,
@@ -78,7 +79,8 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     ForwardBuffers own;  // used only when the caller keeps none (empty until then: no allocation)
     ForwardBuffers& buffers = control.buffers ? *control.buffers : own;
     VoxelStream stream(volume, camera, table, streamOptions, shader, emission, &buffers.stream);
-    ExactContext exact{&camera, volume.voxelSize, settings.simd, pass.prefilterVariance};
+    ExactContext exact{&camera, volume.voxelSize, settings.simd};
+    exact.lowPass = PrefilterRamp(pass.prefilterVariance, pass.magnifiedPrefilterVariance);  // = ctx.lowPass()
     exact.shape = &shape;
     // --compositing slabs: a kernel reaches R·(its longest semi-axis per index unit) along any
     // ray, so K = ⌈R·sMax / slab length⌉ slabs on either side of its own (2 for cubic voxels).
@@ -92,6 +94,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
                           settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
                           pass.prefilterVariance};
+    ctx.magnifiedPrefilterVariance = pass.magnifiedPrefilterVariance;
     ctx.shape = &shape;
     ctx.occlusion = &compositor;
     ctx.vector = settings.simd;
@@ -210,7 +213,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     if (settings.filterOrder == FilterOrder::Prefilter || modeFixesFilterOrder(settings.mode)) {
         const bool none = settings.mode == RenderMode::None;
         const double v = none ? 0.0 : kPrefilterVariance;
-        const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, v, v};
+        const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, v, v, v};
         const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, tables.kernel()), 0);
         const auto at = [&](int x0, int y0) {
             return [&camera, x0, y0](const FrameView& f) { return placed(f, x0, y0, camera.width(), camera.height()); };
@@ -227,7 +230,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     const Camera fine = subpixelCamera(camera, grid);
     const int k = grid.k;
     const ForwardPass pass{subpixelThreshold(settings.threshold, k), settings.lodPx * k, grid.fineVariance,
-                           grid.fineVariance * k};
+                           grid.magnifiedVariance, grid.fineVariance * k};
     // Deposits reach depositReachPx sub-pixels (≤ that many pixels) past the kernels; the output
     // pixels they reach through the filter lie within `border` more; the crop of the sub-pixel
     // image is that output rectangle with its own border, as subpixelCamera frames the whole image.

@@ -22,7 +22,8 @@ SubpixelGrid makeSubpixelGrid(int k, double prefilterVariance) {
     g.k = k;
     // V_s/k² may not exceed V_h: keep at least a quarter of the low-pass for the image.
     g.fineVariance = std::min(kSubpixelPrefilterVariance, 0.75 * prefilterVariance * k * k);
-    g.postVariance = prefilterVariance - g.fineVariance / (double(k) * k);
+    g.magnifiedVariance = std::min(kSubpixelMagnifiedVariance, g.fineVariance);
+    g.postVariance = prefilterVariance - g.magnifiedVariance / (double(k) * k);
     g.border = int(std::ceil(kPrefilterCutoffSigmas * std::sqrt(g.postVariance)));
     return g;
 }

@@ -6,11 +6,13 @@
 // al. 2001, eq. 18–20: ρ = (reconstruction footprint) ⊗ h) folds h_p into each primitive's
 // optical depth before compositing instead; for structures one or two pixels wide
 // exp(−h_p∗τ) is darker than h_p∗exp(−τ) (Jensen; DESIGN §8.3). Here the primitives carry
-// only a small low-pass V_s (in sub-pixels², so the sub-pixel grid does not alias) and the
+// only a small low-pass (in sub-pixels², so the sub-pixel grid does not alias): V_s when
+// minified, easing to V_m ≤ V_s when magnified (PrefilterRamp, footprint/prefilter.h); and the
 // image gets the rest: with k sub-pixels per axis,
-//     V_post = V_h − V_s / k²          [px²]
-// so the total low-pass is V_h as before (Gaussian variances add under convolution), and
-// only V_s/k² of it is applied before the exponential. Energy is unchanged: each primitive's
+//     V_post = V_h − V_m / k²          [px²]
+// so the total low-pass is V_h for a magnified primitive and at most (V_s − V_m)/k² more for a
+// minified one (Gaussian variances add under convolution), and only V_s/k² or less of it is
+// applied before the exponential. Energy is unchanged: each primitive's
 // deposit keeps its total (DESIGN §4), and the weights of every output pixel sum to 1.
 #pragma once
 #include <vector>
@@ -27,11 +29,23 @@ namespace vdbsplat {
 /// position instead of snapping to the nearest pixel.
 inline constexpr double kSubpixelPrefilterVariance = 0.1;
 
+/// The low-pass kept on magnified primitives (projected spacing ≥ 1 sub-pixel; PrefilterRamp
+/// eases to it from V_s at ½), in sub-pixel²: a splat is a kernel a pixel or more wide that moves with its
+/// centre, so the point's reason for V_s does not apply, and every bit folded in before the
+/// exponential is error against the reference. Against V_s everywhere (400², `--spp 16`
+/// references; docs/fidelity.md, "Session 26"): the framed Engine 64.58 → 69.25 dB, the framed
+/// tubes 59.41 → 64.00, every framed and close cell better or equal, the far cells unchanged but
+/// for the postfilter's 0.05 px² less (−0.13 to +1.4 dB).
+inline constexpr double kSubpixelMagnifiedVariance = 0.05;
+
 struct SubpixelGrid {
     int k = 1;                    ///< sub-pixels per pixel and axis
     int border = 0;               ///< pixels rendered beyond each image edge (the filter's reach)
-    double fineVariance = 0.0;    ///< V_s, sub-pixel² (what ProjectionContext::prefilterVariance gets)
-    double postVariance = 0.0;    ///< V_post = V_h − V_s/k², px²
+    double fineVariance = 0.0;    ///< V_s, sub-pixel²: minified primitives' (ProjectionContext::prefilterVariance)
+    double magnifiedVariance = 0.0;  ///< V_m ≤ V_s, sub-pixel²: magnified ones' (ProjectionContext::magnifiedPrefilterVariance)
+    /// V_post = V_h − V_m/k², px²: a magnified primitive's low-pass is V_h in all, a minified
+    /// one's V_h + (V_s − V_m)/k² (0.05 px² more at k = 1).
+    double postVariance = 0.0;
 };
 
 /// @brief The grid for @p k sub-pixels per axis (k ≥ 1) and the prefilter @p prefilterVariance.

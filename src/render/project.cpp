@@ -27,13 +27,14 @@ glm::vec3 splatTint(const glm::vec3& c) {
     return glm::vec3(1.0f, 0.12f, 0.12f) * luma;
 }
 
-Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, float spreadPx2, const ProjectionContext& ctx) {
+/// A point of filter spacing @p spacingPx carrying the low-pass @p lowPass (px²; ctx.lowPass()).
+Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, double lowPass, float spreadPx2, const ProjectionContext& ctx) {
     Primitive p;
     const PixelCoord centre = ctx.camera.project(c);
     if (!std::isfinite(centre.x) || !std::isfinite(centre.y)) return p;
     p.kind = PrimitiveKind::Point;
     p.centre = glm::vec2(centre);
-    p.variance = float(pointFilterVariance(spacingPx, ctx.prefilterVariance, ctx.tables.kernel->sigma()) + spreadPx2);  // + an aggregate's spread (DESIGN §8.2)
+    p.variance = float(pointFilterVariance(spacingPx, lowPass, ctx.tables.kernel->sigma()) + spreadPx2);  // + an aggregate's spread (DESIGN §8.2)
     // σ·M·(f/z)²·(D/z) with σ per world unit = sigma / h (DESIGN §4).
     p.total = float(pointDepositTotal(sigma / ctx.voxelSize, ctx.voxelSize, ctx.camera.focal(), c));
     PixelBox box;
@@ -108,7 +109,7 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, const Pr
 /// read by the compositor's exact-index path. τ = σ_world·L·F(d), L the world length per index
 /// length, taken along the centre ray (it varies by ~(anisotropy)·α over the footprint;
 /// docs/kernel.md, "Any voxel shape"); kernels at the eye take the exact half-ray integral.
-Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, const ProjectionContext& ctx) {
+Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, double lowPass, const ProjectionContext& ctx) {
     Primitive p;
     const VoxelShape& shape = *ctx.shape;
     const EllipsoidProjection e = projectEllipsoid(shape, c, ctx.camera.focal(), ctx.camera.principal());
@@ -122,7 +123,7 @@ Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, const ProjectionC
             p.range = pixelRange(e.ellipse.bounds, ctx.camera.width(), ctx.camera.height());
             break;
         case SphereClass::Ellipse: {
-            const ScreenKernel kernel = makeScreenKernel(e.ellipse, ctx.prefilterVariance);
+            const ScreenKernel kernel = makeScreenKernel(e.ellipse, lowPass);
             p.kind = PrimitiveKind::SplatExactIndex;
             p.centre = glm::vec2(kernel.centre);
             p.conic = glm::vec3(kernel.conic[0][0], kernel.conic[0][1], kernel.conic[1][1]);
@@ -211,7 +212,7 @@ std::optional<PointLaneContext> pointLaneContext(const ProjectionContext& ctx) {
     lanes.spacingTimesFocal = ctx.voxelSize * ctx.camera.focal();
     lanes.threshold = pointsOnly ? INFINITY : ctx.threshold;  // point mode: every voxel in front of the eye
     lanes.voxelSize = ctx.voxelSize;
-    lanes.prefilterVariance = ctx.prefilterVariance;
+    lanes.lowPass = ctx.lowPass();
     lanes.kernelSigma = ctx.tables.kernel->sigma();
     lanes.width = ctx.camera.width(), lanes.height = ctx.camera.height();
     lanes.table = &standardPointFilterTable();
@@ -229,8 +230,10 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
                        : drawsOnlySplats(ctx.mode) ? false
                                                    : spacingPx < ctx.threshold;
     const double filterPx = ellipsoid && c.z > 0.0 ? ctx.shape->projectedSpacing() * ctx.camera.focal() / c.z : spacingPx;
-    Primitive p = point       ? makePoint(c, sigma, filterPx, spreadPx2, ctx)
-                  : ellipsoid ? makeEllipsoidSplat(c, sigma, ctx)
+    // The low-pass by the spacing that decides point or splat: the same on both sides of the switch.
+    const double lowPass = ctx.lowPass().at(spacingPx);
+    Primitive p = point       ? makePoint(c, sigma, filterPx, lowPass, spreadPx2, ctx)
+                  : ellipsoid ? makeEllipsoidSplat(c, sigma, lowPass, ctx)
                               : makeSplat(c, sigma, spacingPx, ctx);
     if (point && ctx.mode == RenderMode::None && p.kind == PrimitiveKind::Point)
         snapToNearestPixel(p, ctx.camera.width(), ctx.camera.height());
@@ -261,7 +264,8 @@ std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx) {
     lanes.focal = ctx.camera.focal();
     lanes.principalX = ctx.camera.principal().x, lanes.principalY = ctx.camera.principal().y;
     lanes.radius = ctx.tables.kernel->radius() * ctx.voxelSize;  // makeSplat's sphere
-    lanes.widen = supportWidening(*ctx.tables.kernel, ctx.prefilterVariance);
+    lanes.widenPerVariance = supportWideningPerVariance(*ctx.tables.kernel);
+    lanes.lowPass = ctx.lowPass();
     lanes.spacingTimesFocal = ctx.voxelSize * ctx.camera.focal();
     lanes.threshold = ctx.threshold;
     lanes.pointsBelow = ctx.mode == RenderMode::Hybrid;

@@ -35,9 +35,12 @@ struct ProjectionContext {
     double threshold;     ///< τ in pixels
     FootprintPath footprint;
     bool showPrimitives;
-    /// The screen low-pass V_h folded into every primitive (px²): kPrefilterVariance, or the
-    /// sub-pixel grid's small one when the prefilter is applied after compositing (postfilter.h).
+    /// The screen low-pass V_h folded into every minified primitive (px²): kPrefilterVariance, or
+    /// the sub-pixel grid's small one when the prefilter is applied after compositing (postfilter.h).
     double prefilterVariance = kPrefilterVariance;
+    /// The low-pass folded into magnified primitives (px²), where the ramp from prefilterVariance
+    /// ends (lowPass()): the same, or the sub-pixel grid's smaller one.
+    double magnifiedPrefilterVariance = kPrefilterVariance;
     /// The kernels' shape in view space (footprint/ellipsoid.h); null or a sphere: the sphere
     /// paths. An ellipsoid (anisotropic or sheared voxels) decides point/splat by its longest
     /// axis, filters points with its projected spacing, and is splatted through its exact
@@ -55,6 +58,10 @@ struct ProjectionContext {
     /// kernel's tabulated marginal `marginal` (required when slabs.on).
     SlabCompositing slabs = {};
     const MarginalCdfTable* marginal = nullptr;
+
+    /// The low-pass of a primitive by its projected spacing: prefilterVariance up to half a
+    /// pixel, magnifiedPrefilterVariance from one (footprint/prefilter.h).
+    PrefilterRamp lowPass() const { return PrefilterRamp(prefilterVariance, magnifiedPrefilterVariance); }
 };
 
 /// What one window's primitives draw, before the compositor's occlusion culling (integer sums:

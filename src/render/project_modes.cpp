@@ -13,7 +13,7 @@ namespace vdbsplat {
 void fillEwaSplat(Primitive& p, const glm::dvec3& c, float sigma, const ProjectionContext& ctx) {
     const EwaKernel k =
         makeEwaKernel(ctx.camera, c, ctx.voxelSize, ctx.tables.kernel->sigma(), ctx.tables.kernel->radius(),
-                      ctx.prefilterVariance);
+                      ctx.prefilterVariance);  // EWA's filter order is fixed: its ramp is flat
     if (!(k.amplitude > 0.0)) {
         p.kind = PrimitiveKind::Culled;
         return;
@@ -31,8 +31,9 @@ bool keepsTablePath(double spacingPx, const ProjectionContext& ctx) {
 }
 
 ScreenKernel splatKernelFor(const SphereProjection& sphere, double spacingPx, const ProjectionContext& ctx) {
-    if (keepsTablePath(spacingPx, ctx)) return makeSwanKernel(sphere, ctx.prefilterVariance, *ctx.tables.kernel);
-    return makeScreenKernel(sphere, ctx.prefilterVariance, *ctx.tables.kernel);
+    const double lowPass = ctx.lowPass().at(spacingPx);  // V_h, or the sub-pixel grid's ramp (render/project.h)
+    if (keepsTablePath(spacingPx, ctx)) return makeSwanKernel(sphere, lowPass, *ctx.tables.kernel);
+    return makeScreenKernel(sphere, lowPass, *ctx.tables.kernel);
 }
 
 void snapToNearestPixel(Primitive& p, int width, int height) {

@@ -37,6 +37,16 @@ HWY_INLINE V LastPixel(D d, V hi, V size) {
     return hn::IfThenElse(hn::Gt(i, t), hn::Sub(i, one), i);
 }
 
+/// PrefilterRamp::at, vectors at a time (the same double operations): the low-pass V at spacing
+/// @p s, minified − span·(s − kStart)·kInvWidth on the ramp.
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V LowPassAt(D d, const PrefilterRamp& ramp, V s) {
+    const V minified = hn::Set(d, ramp.minified), span = hn::Set(d, ramp.span);
+    const V t = hn::Mul(hn::Sub(s, hn::Set(d, PrefilterRamp::kStart)), hn::Set(d, PrefilterRamp::kInvWidth));
+    const V inside = hn::IfThenElse(hn::Lt(t, hn::Set(d, 1.0)), hn::Sub(minified, hn::Mul(span, t)), hn::Sub(minified, span));
+    return hn::IfThenElse(hn::Gt(t, hn::Zero(d)), inside, minified);
+}
+
 void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
     const hn::ScalableTag<double> d;
     using V = hn::Vec<decltype(d)>;
@@ -44,7 +54,8 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
     const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
     const V f = hn::Set(d, ctx.focal), px = hn::Set(d, ctx.principalX), py = hn::Set(d, ctx.principalY);
     const V r = hn::Set(d, ctx.radius), r2 = hn::Set(d, ctx.radius * ctx.radius), fr = hn::Set(d, ctx.focal * ctx.radius);
-    const V widen = hn::Set(d, ctx.widen), hf = hn::Set(d, ctx.spacingTimesFocal), threshold = hn::Set(d, ctx.threshold);
+    const V widenPerVariance = hn::Set(d, ctx.widenPerVariance), hf = hn::Set(d, ctx.spacingTimesFocal);
+    const V threshold = hn::Set(d, ctx.threshold);
     const V minDen = hn::Set(d, 1e-12), exactBound = hn::Set(d, ctx.exactIndexError);
     const V width = hn::Set(d, double(ctx.width)), height = hn::Set(d, double(ctx.height));
     const V invR2 = hn::Set(d, 1.0 / (ctx.radius * ctx.radius)), invF = hn::Set(d, 1.0 / ctx.focal);
@@ -52,7 +63,8 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         const V x = hn::Load(d, L.x + i), y = hn::Load(d, L.y + i), z = hn::Load(d, L.z + i);
         // projectVoxel: in hybrid a point where h·f/z < threshold (z > 0 here).
         auto handled = hn::And(hn::And(hn::IsFinite(x), hn::IsFinite(y)), hn::And(hn::IsFinite(z), hn::Gt(z, zero)));
-        if (ctx.pointsBelow) handled = hn::And(handled, hn::Not(hn::Lt(hn::Div(hf, z), threshold)));
+        const V spacing = hn::Div(hf, z);  // projectVoxel's h·f/z
+        if (ctx.pointsBelow) handled = hn::And(handled, hn::Not(hn::Lt(spacing, threshold)));
         if (hn::AllFalse(d, handled)) {  // all points (far views) or the scalar path's: nothing to do
             for (size_t k = 0; k < N && i + k < n; ++k) L.status[i + k] = SplatLanes::kScalar;
             continue;
@@ -78,6 +90,8 @@ void ProjectSplats(SplatLanes& L, size_t n, const SplatLaneContext& ctx) {
         const V b = hn::Div(fr, hn::Sqrt(q));
         // makeScreenKernel: a' = √(a² + w), b' = √(b² + w); conic = inFrame(u, (1/a')², (1/b')²),
         // pullback = inFrame(u, a·(1/a'), b·(1/b')) with inFrame(u, X, Y) = X·u uᵀ + Y·v vᵀ, v = (−u.y, u.x).
+        // supportWidening(kernel, V) with V = lowPass.at(h·f/z) (splatKernelFor).
+        const V widen = hn::Mul(widenPerVariance, hn::Max(LowPassAt(d, ctx.lowPass, spacing), zero));
         const V aw = hn::Sqrt(hn::Add(hn::Mul(a, a), widen)), bw = hn::Sqrt(hn::Add(hn::Mul(b, b), widen));
         const V uxux = hn::Mul(ux, ux), uyuy = hn::Mul(uy, uy), uyux = hn::Mul(uy, ux);
         const V vx = hn::Neg(uy), vy = ux;
@@ -153,7 +167,7 @@ void PointBoxes(const SplatLanes& L, PointLanes& P, size_t m, const PointLaneCon
     const V f = hn::Set(d, ctx.focal), px = hn::Set(d, ctx.principalX), py = hn::Set(d, ctx.principalY);
     const V hf = hn::Set(d, ctx.spacingTimesFocal), threshold = hn::Set(d, ctx.threshold);
     const V h = hn::Set(d, ctx.voxelSize), M = hn::Set(d, ctx.voxelSize * ctx.voxelSize * ctx.voxelSize);
-    const V prefilter = hn::Set(d, ctx.prefilterVariance), sg = hn::Set(d, ctx.kernelSigma);
+    const V sg = hn::Set(d, ctx.kernelSigma);
     const V maxRadius = hn::Set(d, kPointMaxRadiusPx), sigmas = hn::Set(d, kPointSupportSigmas);
     const V maxSide = hn::Set(d, double(kPointMaxSide));
     const V width = hn::Set(d, double(ctx.width)), height = hn::Set(d, double(ctx.height));
@@ -177,6 +191,7 @@ void PointBoxes(const SplatLanes& L, PointLanes& P, size_t m, const PointLaneCon
         const V cx = hn::Add(px, hn::Div(hn::Mul(f, x), z)), cy = hn::Sub(py, hn::Div(hn::Mul(f, y), z));
         // pointFilterVariance(h·f/z) + spread: (V_h + (s_g·spacing)²) + spread, rounded to float.
         const V s = hn::Mul(sg, spacing);
+        const V prefilter = LowPassAt(d, ctx.lowPass, spacing);  // projectVoxel's lowPass.at(h·f/z)
         const auto varianceF = hn::DemoteTo(df, hn::Add(hn::Add(prefilter, hn::Mul(s, s)), hn::PromoteTo(d, hn::Load(df, P.spread + i))));
         // pointDepositTotal(σ/h, h, f, c): σ_w·M·(f/z)·(f/z)·(|c|/z), |c| = √((x² + y²) + z²).
         const V fz = hn::Div(f, z);

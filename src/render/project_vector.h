@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "footprint/pixel_box.h"
+#include "footprint/prefilter.h"
 #include "footprint/screen_kernel.h"
 
 namespace vdbsplat {
@@ -27,7 +28,8 @@ struct SplatLaneContext {
     double focal = 1.0;               ///< f (pixels)
     double principalX = 0.0, principalY = 0.0;
     double radius = 0.0;              ///< the kernel sphere's radius r = R·h (world units)
-    double widen = 0.0;               ///< (R/s_g)²·V_h: the low-pass on the support semi-axes² (px²)
+    double widenPerVariance = 0.0;    ///< (R/s_g)²: a low-pass V widens the support semi-axes² by it·V (px²)
+    PrefilterRamp lowPass;            ///< V by the projected spacing h·f/z (ProjectionContext::lowPass)
     double spacingTimesFocal = 0.0;   ///< h·f: the projected spacing is h·f/z
     double threshold = 0.0;           ///< hybrid: a splat where h·f/z ≥ threshold; ignored when !pointsBelow
     bool pointsBelow = true;          ///< hybrid (points below the threshold); false: every voxel a splat
@@ -77,7 +79,7 @@ struct PointLaneContext {
     double spacingTimesFocal = 0.0;      ///< h·f: the projected spacing is h·f/z
     double threshold = 0.0;              ///< a point where h·f/z < threshold (point mode: +∞)
     double voxelSize = 1.0;              ///< h (world units)
-    double prefilterVariance = 0.0;      ///< V_h folded into each point (px²)
+    PrefilterRamp lowPass;               ///< V folded into each point by its spacing h·f/z (px²)
     double kernelSigma = 1.0;            ///< s_g (voxels)
     int width = 0, height = 0;           ///< image size (pixels)
     const PointFilterTable* table = nullptr;  ///< the points' filter (standardPointFilterTable)

@@ -9,6 +9,7 @@
 //   missing low-pass      → FidelityAgainstTheReference (splat mode, far view)
 //   wrong depth order     → FrontSlabOccludesTheBackSlab
 //   lost slab             → UniformSlabTransmitsExpMinusSigmaL (point path)
+#include <algorithm>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -297,8 +298,11 @@ TEST(Forward, AutoFootprintTakesTheExactIndexOnlyOffAxis) {
 }
 
 // The point/splat switch does not show: moving the threshold τ from 0.7 to 1.4 px changes
-// the image far less than the hybrid differs from the reference (measured 59.5 dB between,
-// 39.5 dB to the reference; a point energy 5 % off gives 51.9 dB between and must fail).
+// the image far less than the hybrid differs from the reference, and hardly at all (measured
+// 74.7 dB between, 60.9 dB to the reference; before session 26's smaller low-pass on magnified
+// primitives 75.2 and 57.3, so the bound went from the reference + 15 dB to + 12 dB and at
+// least 72 dB, more than the 72.3 it asked then; a point energy 5 % off gives 51.9 dB between
+// and must fail).
 TEST(Forward, ThresholdSwitchIsSeamless) {
     const TransferFunction tf = TransferFunction::preset("grey");
     RenderSettings s = settingsFor(RenderMode::Hybrid, 1.0);
@@ -315,7 +319,7 @@ TEST(Forward, ThresholdSwitchIsSeamless) {
     const Image& reference = referenceOf("marschner-lobb", marschnerLobb(), tf, s);
     const double toReference = std::min(compareImages(a, reference).psnr, compareImages(b, reference).psnr);
     std::printf("  τ 0.7 vs 1.4: %.2f dB; hybrid vs reference: %.2f dB\n", between, toReference);
-    EXPECT_GT(between, toReference + 15.0);
+    EXPECT_GT(between, std::max(toReference + 12.0, 72.0));
 }
 
 // A zoom animation through the switch does not pop: along a geometric camera path on which

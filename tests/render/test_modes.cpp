@@ -39,8 +39,10 @@ ViewPoint at(double D, double theta, double phi = 0.4) {
 
 /// The context renderForward gives @p mode: V_h in each primitive, none for --mode none.
 ProjectionContext contextFor(const Camera& cam, RenderMode mode, double h, FootprintPath path = FootprintPath::Table) {
-    return ProjectionContext{cam,  tables(), h,     h, mode, 1.0, path, false,
-                             mode == RenderMode::None ? 0.0 : kPrefilterVariance};
+    const double v = mode == RenderMode::None ? 0.0 : kPrefilterVariance;
+    ProjectionContext ctx{cam, tables(), h, h, mode, 1.0, path, false, v};
+    ctx.magnifiedPrefilterVariance = v;
+    return ctx;
 }
 
 /// τ of a Point or (table-path) Splat primitive at pixel (x, y): the compositor's maths, slowly.

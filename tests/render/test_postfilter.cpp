@@ -48,7 +48,10 @@ Image bruteForce(const Image& fine, const SubpixelGrid& g, int width, int height
 TEST(Postfilter, VariancesAddUpToThePrefilter) {
     for (int k = 1; k <= kMaxSubpixels; ++k) {
         const SubpixelGrid g = makeSubpixelGrid(k, kPrefilterVariance);
-        EXPECT_NEAR(g.fineVariance / (k * k) + g.postVariance, kPrefilterVariance, 1e-12) << k;
+        // A magnified primitive's total low-pass is V_h; a minified one's V_h + (V_s − V_m)/k².
+        EXPECT_NEAR(g.magnifiedVariance / (k * k) + g.postVariance, kPrefilterVariance, 1e-12) << k;
+        EXPECT_GT(g.magnifiedVariance, 0.0) << k;
+        EXPECT_LE(g.magnifiedVariance, g.fineVariance) << k;
         EXPECT_GT(g.postVariance, 0.0) << k;
         EXPECT_GE(g.border, kPrefilterCutoffSigmas * std::sqrt(g.postVariance)) << k;
     }

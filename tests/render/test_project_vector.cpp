@@ -103,6 +103,7 @@ TEST(ProjectVector, LanesEqualTheScalarProjection) {
         for (const FootprintPath footprint : {FootprintPath::Auto, FootprintPath::Table})
             for (const double prefilter : {kPrefilterVariance, 0.1, 0.0}) {
                 ProjectionContext ctx{camera, tables(), 0.1, 0.1, mode, 1.0, footprint, false, prefilter};
+                ctx.magnifiedPrefilterVariance = 0.5 * prefilter;  // the ramp between τ and 2τ (lowPass), in both paths
                 SCOPED_TRACE(toString(mode) + " prefilter " + std::to_string(prefilter));
                 Coverage cov;
                 checkLanes(ctx, voxels, cov);
@@ -193,6 +194,7 @@ TEST(ProjectVector, PointLanesEqualTheScalarProjection) {
         for (const double prefilter : {kPrefilterVariance, 0.1, 0.0}) {
             const RenderMode mode = threshold > 0.0 ? RenderMode::Hybrid : RenderMode::Point;
             ProjectionContext ctx{camera, tables(), 0.1, 0.1, mode, threshold, FootprintPath::Auto, false, prefilter};
+            ctx.magnifiedPrefilterVariance = 0.5 * prefilter;
             SCOPED_TRACE(toString(mode) + " threshold " + std::to_string(threshold) + " prefilter " + std::to_string(prefilter));
             test::forEachTarget([&] {
                 Coverage cov;  // splats: points taken; offImage: culled points; exact: fallbacks; declined: not points
