@@ -35,7 +35,7 @@ inline constexpr double kSubpixelPrefilterVariance = 0.1;
 /// exponential is error against the reference. Against V_s everywhere (400², `--spp 16`
 /// references; docs/fidelity.md, "Session 26"): the framed Engine 64.58 → 69.25 dB, the framed
 /// tubes 59.41 → 64.00, every framed and close cell better or equal, the far cells unchanged but
-/// for the postfilter's 0.05 px² less (−0.13 to +1.4 dB).
+/// for the postfilter's 0.05 px² less (−0.13 to +1.7 dB).
 inline constexpr double kSubpixelMagnifiedVariance = 0.05;
 
 struct SubpixelGrid {
