@@ -4,6 +4,7 @@
 // z > 0 in front of the eye). Pixel space: x right, y down, pixel (i, j) covers
 // [i, i+1) × [j, j+1), its centre is (i + 0.5, j + 0.5).
 #pragma once
+#include <cmath>
 #include <glm/glm.hpp>
 #include <string>
 
@@ -59,6 +60,9 @@ public:
     const glm::dvec3& up() const { return up_; }
     const glm::dvec3& lookAt() const { return lookAt_; }
     double focal() const { return focal_; }        ///< focal length f in pixels
+    /// A world @p length at view depth @p z in pixels, length·f/z (+∞ at or behind the eye plane):
+    /// a voxel's projected spacing, as the projection and the compositor's rebuilds take it.
+    double spacingPx(double length, double z) const { return z > 0.0 ? length * focal_ / z : INFINITY; }
     PixelCoord principal() const { return principal_; }
     int width() const { return width_; }
     int height() const { return height_; }

@@ -642,10 +642,8 @@ void TileCompositor::drawExact(const TileRecord& p, const PrimitiveExtra& extra,
     // Ellipse, and then takes the half-ray fallback like a NearEye kernel.
     const bool widened = p.kind != PrimitiveKind::NearEye && sphere.isEllipse();
     ScreenKernel kernel;
-    if (widened) {  // the projection's low-pass: at its spacing h·f/z (projectVoxel)
-        const double spacingPx = extra.viewPos.z > 0.f ? h * camera.focal() / double(extra.viewPos.z) : INFINITY;
-        kernel = makeScreenKernel(sphere, exact_.lowPass.at(spacingPx), shape);
-    }
+    // The projection's low-pass, at its spacing (projectVoxel).
+    if (widened) kernel = makeScreenKernel(sphere, exact_.lowPass.at(camera.spacingPx(h, extra.viewPos.z)), shape);
     const int x0 = std::max(p.range.x0, px.x0), x1 = std::min(p.range.x1, px.x1);
     const int y0 = std::max(p.range.y0, px.y0), y1 = std::min(p.range.y1, px.y1);
     const double sigmaWorld = extra.sigma / h;

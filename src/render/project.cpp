@@ -61,7 +61,8 @@ void setUpPointFilter(Primitive& p, int width, int height, bool vector) {
     p.range.x1 = std::min(s.x0 + s.nx - 1, width - 1), p.range.y1 = std::min(s.y0 + s.ny - 1, height - 1);
 }
 
-Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, const ProjectionContext& ctx) {
+/// A splat of projected spacing @p spacingPx carrying the low-pass @p lowPass (px²; ctx.lowPass()).
+Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, double lowPass, const ProjectionContext& ctx) {
     Primitive p;
     const double h = ctx.voxelSize;
     const SphereProjection sphere = projectSphere(ctx.camera, c, ctx.tables.kernel->radius() * h);
@@ -79,7 +80,7 @@ Primitive makeSplat(const glm::dvec3& c, float sigma, double spacingPx, const Pr
                 fillEwaSplat(p, c, sigma, ctx);
                 break;
             }
-            const ScreenKernel kernel = splatKernelFor(sphere, spacingPx, ctx);  // Swan's stretch or V + V_h
+            const ScreenKernel kernel = splatKernelFor(sphere, spacingPx, lowPass, ctx);  // Swan's stretch or V + V_h
             p.kind = keepsTablePath(spacingPx, ctx)            ? PrimitiveKind::Splat
                      : ctx.footprint == FootprintPath::Exact ? PrimitiveKind::SplatExact
                      : ctx.footprint == FootprintPath::Auto && sphere.affineIndexError() > kAutoExactIndexError
@@ -224,7 +225,7 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
     const bool ellipsoid = ctx.shape && !ctx.shape->sphere;
     // The projected voxel spacing h·f/z; for an ellipsoid its longest axis (a splat as soon as any
     // axis is magnified) decides, and its projected spacing sets the point filter.
-    const double spacingPx = c.z > 0.0 ? (ellipsoid ? ctx.shape->sMax : ctx.voxelSize) * ctx.camera.focal() / c.z : INFINITY;
+    const double spacingPx = ctx.camera.spacingPx(ellipsoid ? ctx.shape->sMax : ctx.voxelSize, c.z);
     // Hybrid and None switch on the threshold; Splat, Ewa and Swan draw every voxel as a splat.
     const bool point = ctx.mode == RenderMode::Point ? c.z > 0.0
                        : drawsOnlySplats(ctx.mode) ? false
@@ -234,7 +235,7 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
     const double lowPass = ctx.lowPass().at(spacingPx);
     Primitive p = point       ? makePoint(c, sigma, filterPx, lowPass, spreadPx2, ctx)
                   : ellipsoid ? makeEllipsoidSplat(c, sigma, lowPass, ctx)
-                              : makeSplat(c, sigma, spacingPx, ctx);
+                              : makeSplat(c, sigma, spacingPx, lowPass, ctx);
     if (point && ctx.mode == RenderMode::None && p.kind == PrimitiveKind::Point)
         snapToNearestPixel(p, ctx.camera.width(), ctx.camera.height());
     if (p.kind == PrimitiveKind::Point) setUpPointFilter(p, ctx.camera.width(), ctx.camera.height(), ctx.vector);

@@ -30,8 +30,7 @@ bool keepsTablePath(double spacingPx, const ProjectionContext& ctx) {
     return ctx.mode == RenderMode::Swan && spacingPx < ctx.threshold;
 }
 
-ScreenKernel splatKernelFor(const SphereProjection& sphere, double spacingPx, const ProjectionContext& ctx) {
-    const double lowPass = ctx.lowPass().at(spacingPx);  // V_h, or the sub-pixel grid's ramp (render/project.h)
+ScreenKernel splatKernelFor(const SphereProjection& sphere, double spacingPx, double lowPass, const ProjectionContext& ctx) {
     if (keepsTablePath(spacingPx, ctx)) return makeSwanKernel(sphere, lowPass, *ctx.tables.kernel);
     return makeScreenKernel(sphere, lowPass, *ctx.tables.kernel);
 }

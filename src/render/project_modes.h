@@ -29,8 +29,8 @@ void fillEwaSplat(Primitive& p, const glm::dvec3& c, float sigma, const Projecti
 
 /// @brief The screen kernel a splat of the Ellipse @p sphere gets in ctx.mode: Swan's stretch
 /// for a minified voxel (projected spacing @p spacingPx < ctx.threshold) under --mode swan, the
-/// EWA-widened exact ellipse (makeScreenKernel with ctx.lowPass() at @p spacingPx) otherwise.
-ScreenKernel splatKernelFor(const SphereProjection& sphere, double spacingPx, const ProjectionContext& ctx);
+/// EWA-widened exact ellipse (makeScreenKernel with @p lowPass, ctx.lowPass() at @p spacingPx) otherwise.
+ScreenKernel splatKernelFor(const SphereProjection& sphere, double spacingPx, double lowPass, const ProjectionContext& ctx);
 
 /// @brief True when the splat of @p spacingPx must take the table path whatever --footprint says
 /// (a Swan-stretched kernel: the compositor's exact path would rebuild hybrid's kernel).
