@@ -218,19 +218,23 @@ SkippedPrimitives TileCompositor::binWindow(const ProjectedWindow& window) {
     std::vector<ChunkRange> range(chunks.count);
     std::vector<SkippedPrimitives> skippedIn(chunks.count);
     const uint64_t* tilesOf = window.tiles.data();
-    const auto forTiles = [&](uint64_t rect, auto&& fn) {  // rect: tileRect of the primitive's range
+    const int* live = liveCount_.data();
+    const size_t tilesX = size_t(tilesX_);
+    // Everything the loops read through locals: a store through a count or an entry could alias a
+    // member or a captured reference, and the compiler reloaded them every primitive.
+    const auto forTiles = [live, tilesX](uint64_t rect, auto&& fn) {  // rect: tileRect of the primitive's range
         const size_t tx0 = rect & 0xffff, ty0 = rect >> 16 & 0xffff, tx1 = rect >> 32 & 0xffff, ty1 = rect >> 48;
         for (size_t ty = ty0; ty <= ty1; ++ty)
-            for (size_t tile = ty * tilesX_ + tx0, last = ty * tilesX_ + tx1; tile <= last; ++tile)
-                if (liveCount_[tile] > 0) fn(tile);
+            for (size_t tile = ty * tilesX + tx0, last = ty * tilesX + tx1; tile <= last; ++tile)
+                if (live[tile] > 0) fn(tile);
     };
     // Per chunk: the drawable primitives' key range (all of them, as the layout always took) and
     // the tiles each counts in; a primitive with no live tile is skipped.
     tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
-        uint32_t* count = counts.data() + c * tiles;
-        ChunkRange& r = range[c];
-        SkippedPrimitives& skipped = skippedIn[c];
-        for (size_t i = chunks.begin(c); i < chunks.end(c); ++i) {
+        uint32_t* const count = counts.data() + c * tiles;
+        ChunkRange r;
+        SkippedPrimitives skipped;
+        for (size_t i = chunks.begin(c), end = chunks.end(c); i < end; ++i) {
             const uint32_t o = orderOf[i];
             if (o == ProjectedWindow::kNotDrawn) continue;
             ++r.count;
@@ -246,6 +250,7 @@ SkippedPrimitives TileCompositor::binWindow(const ProjectedWindow& window) {
                 skipped.voxels += window.members[i];
             }
         }
+        range[c] = r, skippedIn[c] = skipped;
     });
     ChunkRange all;
     for (const ChunkRange& r : range) {
@@ -278,13 +283,15 @@ SkippedPrimitives TileCompositor::binWindow(const ProjectedWindow& window) {
     }
     binStart_[tiles] = total;
     growDiscarding(binEntries_, total), growDiscarding(binScratch_, total);
-    tbb::parallel_for(size_t(0), chunks.count, [&](size_t c) {
-        uint32_t* cursor = counts.data() + c * tiles;
-        for (size_t i = chunks.begin(c); i < chunks.end(c); ++i) {
+    Entry* const entries = binEntries_.data();
+    const int indexBits = indexBits_;
+    tbb::parallel_for(size_t(0), chunks.count, [&, layout](size_t c) {
+        uint32_t* const cursor = counts.data() + c * tiles;
+        for (size_t i = chunks.begin(c), end = chunks.end(c); i < end; ++i) {
             const uint32_t o = orderOf[i];
             if (o == ProjectedWindow::kNotDrawn) continue;
-            const Entry e = layout.key(o, depthOf[i]) << indexBits_ | i;
-            forTiles(tilesOf[i], [&](size_t tile) { binEntries_[cursor[tile]++] = e; });
+            const Entry e = layout.key(o, depthOf[i]) << indexBits | i;
+            forTiles(tilesOf[i], [&](size_t tile) { entries[cursor[tile]++] = e; });
         }
     });
     SkippedPrimitives skipped;

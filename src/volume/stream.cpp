@@ -28,7 +28,7 @@ namespace vdbsplat {
 
 namespace {
 constexpr int kBlockDim = 8;  // OpenVDB leaf side; active tiles are split into blocks of this side
-constexpr size_t kMaxWindowBlocks = 512;  // a window grows past its slabs up to this many blocks (recordsOf)
+static const size_t kMaxWindowBlocks = std::getenv("VDBSPLAT_MWB") ? size_t(std::atoi(std::getenv("VDBSPLAT_MWB"))) : 512;  // a window grows past its slabs up to this many blocks (recordsOf)
 constexpr size_t kExtractChunk = 16;      // blocks extracted into one buffer, in order (VoxelStream::next)
 constexpr uint64_t kMaxActiveVoxels = uint64_t(1) << 32;
 }  // namespace
@@ -172,14 +172,17 @@ bool VoxelStream::visible(const Block& b) const {
 }
 
 void VoxelStream::screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const {
-    screenRect(b.origin, b.dim, x0, y0, x1, y1);
+    screenRect(b.origin, b.dim, b.pointsOnly, x0, y0, x1, y1);
 }
 
-void VoxelStream::screenRect(const openvdb::Coord& origin, int dim, int& x0, int& y0, int& x1, int& y1) const {
-    // Project the corners of the box of voxels [origin, origin + dim)³ widened by the kernel radius;
-    // the margin covers the prefilter. Any corner at or behind the eye plane: the whole screen.
-    // The map is affine: one corner through it, then the box's three edges as offsets.
-    const double r = Kernel::kRadius + 0.5, side = double(dim - 1) + 2.0 * r;
+void VoxelStream::screenRect(const openvdb::Coord& origin, int dim, bool points, int& x0, int& y0, int& x1, int& y1) const {
+    // Project the corners of the box of voxel centres [origin, origin + dim)³, widened by the
+    // kernel radius for splats; the margin covers the prefilter and a point's filter (the box of a
+    // point's pixels, centres within kPointMaxRadiusPx of its own, lies within the margin of its
+    // centre: a voxel's, or an aggregate's σ-weighted centroid of voxel centres). Any corner at
+    // or behind the eye plane: the whole screen. The map is affine: one corner through it, then
+    // the box's three edges as offsets.
+    const double r = points ? 0.0 : Kernel::kRadius + 0.5, side = double(dim - 1) + 2.0 * r;
     const glm::dvec3 low(indexToView_ * glm::dvec4(origin.x() - r, origin.y() - r, origin.z() - r, 1.0));
     const glm::dmat3 edges = glm::dmat3(indexToView_) * side;
     double lox = 1e300, loy = 1e300, hix = -1e300, hiy = -1e300;
@@ -196,7 +199,7 @@ void VoxelStream::screenRect(const openvdb::Coord& origin, int dim, int& x0, int
         lox = std::min(lox, p.x), hix = std::max(hix, p.x);
         loy = std::min(loy, p.y), hiy = std::max(hiy, p.y);
     }
-    const double m = options_.screenMargin;
+    const double m = points ? std::max(options_.screenMargin, kPointMaxRadiusPx + 0.5) : options_.screenMargin;
     x0 = int(std::clamp(std::floor(lox - m), 0.0, double(camera_.width() - 1)));
     x1 = int(std::clamp(std::ceil(hix + m), 0.0, double(camera_.width() - 1)));
     y0 = int(std::clamp(std::floor(loy - m), 0.0, double(camera_.height() - 1)));
@@ -221,7 +224,7 @@ bool VoxelStream::visibleOctants(const Block& b, const std::function<bool(int, i
         for (int j = 0; j < 2; ++j)
             for (int k = 0; k < 2; ++k) {
                 int x0, y0, x1, y1;
-                screenRect(b.origin.offsetBy(4 * i, 4 * j, 4 * k), 4, x0, y0, x1, y1);
+                screenRect(b.origin.offsetBy(4 * i, 4 * j, 4 * k), 4, b.pointsOnly, x0, y0, x1, y1);
                 if (hidden(x0, y0, x1, y1)) {
                     any = true;
                     continue;
@@ -235,8 +238,8 @@ bool VoxelStream::visibleOctants(const Block& b, const std::function<bool(int, i
 }
 
 void VoxelStream::lodLevel(Block& b) const {
-    b.lodLevel = 0, b.lodFine = 0.f;
-    if (!(options_.lodCellPx > 0.0) || !(options_.pointBelowPx > 0.0)) return;
+    b.lodLevel = 0, b.lodFine = 0.f, b.pointsOnly = options_.pointBelowPx == INFINITY;  // point mode: all points
+    if (!(options_.pointBelowPx > 0.0)) return;
     const glm::dvec3 centreIdx = glm::dvec3(b.origin.x(), b.origin.y(), b.origin.z()) + 0.5 * (b.dim - 1);
     const glm::dvec3 c(indexToView_ * glm::dvec4(centreIdx, 1.0));
     const double zNear = c.z - blockHalfDiagonal_;  // nearest voxel centre's depth, bounded
@@ -244,6 +247,8 @@ void VoxelStream::lodLevel(Block& b) const {
     // The block's largest projected voxel spacing (the longest voxel axis: as the projection decides).
     const double spacingPx = largestAxis_ * camera_.focal() / zNear;
     if (!(spacingPx < options_.pointBelowPx)) return;     // some voxel may be a splat
+    b.pointsOnly = true;
+    if (!(options_.lodCellPx > 0.0)) return;
     // The admissible level ℓ, continuous: a cell of n = 2^ℓ voxels per side projects to n·s px (at
     // most lodCellPx) and, uniform, would add the spread s²·(n² − 1)/12 px² per axis (s the projected
     // spacing), at most kLodMaxSpreadRatio of the points' own filter variance.

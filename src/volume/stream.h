@@ -248,16 +248,21 @@ private:
         int lodLevel;                   // 0: voxel by voxel; L ≥ 1: aggregates of (2^L)³ cells
         float lodFine;                  // blended: 1 − t, t the passage to lodLevel from lodLevel − 1 (0: lodLevel alone)
         uint32_t id;                    // its place in the grid's leaf-then-tile order (the same every render)
+        bool pointsOnly = false;        // every voxel projects under pointBelowPx: all its records are points
     };
     void collectBlocks();
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
-    void screenRect(const openvdb::Coord& origin, int dim, int& x0, int& y0, int& x1, int& y1) const;
+    /// The pixels the deposits of the voxels [origin, origin + dim)³ can reach: the box of their
+    /// centres, widened by the kernel radius unless @p points (then the centres' box alone: a
+    /// point, voxel or aggregate, is centred inside it and reaches ≤ kPointMaxRadiusPx), plus the
+    /// screen margin.
+    void screenRect(const openvdb::Coord& origin, int dim, bool points, int& x0, int& y0, int& x1, int& y1) const;
     /// The octants of leaf @p b not hidden, as value-mask words (@p visible); adds the active
     /// voxels of the hidden ones to @p occluded. False (nothing set) when no octant is hidden.
     bool visibleOctants(const Block& b, const std::function<bool(int, int, int, int)>& hidden,
                         std::array<uint64_t, 8>& visible, uint64_t& occluded) const;
-    void lodLevel(Block& b) const;  // sets b.lodLevel and b.lodFine
+    void lodLevel(Block& b) const;  // sets b.lodLevel, b.lodFine and b.pointsOnly
     static size_t recordsOf(const Block& b);  // about how many records b's extraction gives
     /// counts: aggregates only. @p visible: the leaf's voxels to extract, as value-mask words
     /// (a level-0 leaf block only); null: all.

@@ -3,6 +3,8 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
+#include <iterator>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -770,6 +772,47 @@ TEST(Stream, HiddenOctantsAreNeitherExtractedNorReleased) {
     EXPECT_GT(left, 1000u);
     EXPECT_LT(left, all.records.size() / 2);
     EXPECT_EQ(culled.occluded - all.occluded, left);
+}
+
+// A block whose voxels are all points (StreamOptions::pointBelowPx) is tested for occlusion by the
+// box of its voxel centres and a point's reach (kPointMaxRadiusPx), not the kernel-widened box a
+// splat needs (VoxelStream::screenRect). With the left part of the image finished, every point the
+// stream leaves out has all its pixels there (centre + 3 px left of the edge: a point draws the
+// pixel centres within 3.5 px of its own), and some lie closer to the edge than the kernel-widened
+// box allowed (its 2.5 voxels each side): the test bites on both sides.
+TEST(Stream, PointBlocksAreCulledByThePointsReach) {
+    const Volume& v = cloud();
+    const Camera camera = framedCamera(v, 512, 1.0);
+    const ClassificationTable table = constantTable(0.05f);
+    const double spacingPx = v.voxelSize * camera.focal() / camera.toView(glm::dvec3(0.0)).z;
+    const int edge = 256;
+    const auto hidden = [&](int, int, int x1, int) { return x1 < edge; };
+    StreamOptions o;
+    o.pointBelowPx = 1e9;  // every voxel a point
+    o.lodCellPx = 0.0;     // one point per voxel
+    std::vector<std::vector<std::array<float, 4>>> runs;
+    for (const bool culling : {false, true}) {
+        VoxelStream stream(v, camera, table, o);
+        VoxelBatch batch;
+        std::vector<std::array<float, 4>> records;
+        while (culling ? stream.next(batch, hidden) : stream.next(batch))
+            for (size_t i = 0; i < batch.size(); ++i)
+                records.push_back({batch.viewPos[i].x, batch.viewPos[i].y, batch.viewPos[i].z, batch.sigma[i]});
+        std::sort(records.begin(), records.end());
+        runs.push_back(std::move(records));
+    }
+    std::vector<std::array<float, 4>> left;
+    std::set_difference(runs[0].begin(), runs[0].end(), runs[1].begin(), runs[1].end(), std::back_inserter(left));
+    EXPECT_EQ(runs[0].size() - runs[1].size(), left.size()) << "the culled stream released a record the other did not";
+    double rightmost = -INFINITY;
+    for (const auto& r : left) {
+        const double x = camera.project(ViewPoint(glm::dvec3(r[0], r[1], r[2]))).x;
+        ASSERT_LE(x + 3.0, double(edge) + 1e-3) << "a point with a pixel right of the edge was culled";
+        rightmost = std::max(rightmost, x);
+    }
+    EXPECT_GT(left.size(), 1000u);
+    // The kernel-widened box culls only points at least 4 px + 2.5 voxels left of the edge.
+    EXPECT_GT(rightmost, edge - 4.0 - 2.5 * spacingPx + 0.25) << "spacing " << spacingPx << " px";
 }
 
 }  // namespace
