@@ -30,12 +30,12 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTargets* slabs, const Sla
     using V = hn::Vec<D>;
     constexpr int N = int(hn::MaxLanes(D()));
     const hn::RebindToSigned<D> di;
-    const PointFilterTable& table = *p.table;
+    const PointFilterWeight& table = *p.table;
     // The tile's columns in vectors of N: the first and last that hold footprint pixels.
     const int c0 = (p.x0 - tileX0) / N * N, c1 = (p.x1 - tileX0) / N * N;
     // Per column and per row of the footprint's part in the tile (once per point and tile): the
     // squared offset and its weight, both axes in one vector of 16 (lanes 0–7 the columns from
-    // p.x0, 8–15 the rows from p.y0: one pair of gathers), then put on the tile's lanes.
+    // p.x0, 8–15 the rows from p.y0: one PointWeight), then put on the tile's lanes.
     alignas(64) float sq[16], g[16];
     AxisWeights(table, p.x0, p.y0, p.cx, p.cy, p.invVariance, sq, g);
     // The columns on the tile's lanes: lanes past the footprint's part hold other columns' values
@@ -96,7 +96,7 @@ void DrawPointPairs(D d, const PointRaster& p, const SlabTargets* slabs, const S
     const hn::Half<D> dh;
     const hn::RebindToSigned<D> di;
     constexpr int kHalf = kPairLanes / 2;
-    const PointFilterTable& table = *p.table;
+    const PointFilterWeight& table = *p.table;
     const int start = std::min(p.x0 - tileX0, kStride - kHalf);  // the window's first column in the tile
     alignas(64) float sq[kPairLanes], g[kPairLanes];  // lanes 0–7 the window's columns, 8–15 the rows
     AxisWeights(table, tileX0 + start, p.y0, p.cx, p.cy, p.invVariance, sq, g);
@@ -191,7 +191,7 @@ void drawPointVector(const PointRaster& p, const SlabTile& tile) { HWY_DYNAMIC_D
 
 void drawPointSlabsScalar(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0) {
     constexpr int kStride = kTileSize;
-    const PointFilterTable& table = *p.table;
+    const PointFilterWeight& table = *p.table;
     for (int y = p.y0; y <= p.y1; ++y) {
         const float dy = PointSetup::offset(y, p.cy), dy2 = dy * dy;
         const float gy = table.weight(dy2 * p.invVariance);

@@ -40,7 +40,7 @@ struct PointRaster {
     glm::vec3 color{0.f};
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  ///< the footprint's pixels inside the tile (inclusive)
     float epsilon = 0.f;             ///< pixels with T < epsilon are finished
-    const PointFilterTable* table = nullptr;
+    const PointFilterWeight* table = nullptr;
 };
 
 /// @brief Adds the point's deposits to the live pixels of @p tile's slab (vector loop).

@@ -22,15 +22,11 @@ double pointDepositTotal(double sigma, double h, double f, const ViewPoint& c) {
     return sigma * M * fz * fz * (glm::length(c) / c.z);
 }
 
-PointFilterTable::PointFilterTable() : v_(kIntervals + 1), scale_(static_cast<float>(kIntervals / kMaxX)) {
-    for (int k = 0; k <= kIntervals; ++k) v_[k] = static_cast<float>(std::exp(-0.5 * kMaxX * k / kIntervals));
-}
-
-double PointFilterTable::maxAbsError() const {
-    constexpr int kSub = 16;
+double PointFilterWeight::maxAbsError() const {
+    constexpr int kSamples = 16384;
     double worst = 0.0;
-    for (int k = 0; k < kIntervals * kSub; ++k) {
-        const float x = static_cast<float>(kMaxX * k / (kIntervals * kSub));
+    for (int k = 0; k < kSamples; ++k) {
+        const float x = static_cast<float>(kMaxX * k / kSamples);
         worst = std::max(worst, std::abs(weight(x) - std::exp(-0.5 * x)));
     }
     return worst;
@@ -45,7 +41,7 @@ void centresWithin(double x, double rs, int& first, int& count) {
 }
 }  // namespace
 
-PointFootprint rasterizePoint(const PointFilterTable& table, const PixelCoord& x, double variance) {
+PointFootprint rasterizePoint(const PointFilterWeight& table, const PixelCoord& x, double variance) {
     PointFootprint out;
     if (!std::isfinite(x.x) || !std::isfinite(x.y) || !(variance > 0.0) || x.x < -1e9 || x.x > 1e9 ||
         x.y < -1e9 || x.y > 1e9)
@@ -118,7 +114,7 @@ void finishPointSetup(PointSetup& s, const PixelCoord& x, float sum, float invV,
     }
 }
 
-PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double variance) {
+PointSetup setupPoint(const PointFilterWeight& table, const PixelCoord& x, double variance) {
     // rasterizePoint's footprint and its sum, in its order (sumColumnsPairwise; a term outside
     // the circle is +0 there and changes no sum), without storing the weights.
     PointSetup s;
@@ -143,9 +139,9 @@ PointSetup setupPoint(const PointFilterTable& table, const PixelCoord& x, double
     return s;
 }
 
-const PointFilterTable& standardPointFilterTable() {
-    static const PointFilterTable table;
-    return table;
+const PointFilterWeight& standardPointFilter() {
+    static const PointFilterWeight filter;
+    return filter;
 }
 
 }  // namespace vdbsplat

@@ -17,7 +17,7 @@ namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 
-PointSetup SetupPoint(const PointFilterTable& table, const PixelCoord& x, double variance) {
+PointSetup SetupPoint(const PointFilterWeight& table, const PixelCoord& x, double variance) {
     PointSetup s;
     float invV = 0.0f, rs2 = 0.0f;
     if (!pointSetupBox(x, variance, s, invV, rs2)) return s;
@@ -54,7 +54,7 @@ namespace vdbsplat {
 
 HWY_EXPORT(SetupPoint);
 
-PointSetup setupPointVector(const PointFilterTable& table, const PixelCoord& x, double variance) {
+PointSetup setupPointVector(const PointFilterWeight& table, const PixelCoord& x, double variance) {
     return HWY_DYNAMIC_DISPATCH(SetupPoint)(table, x, variance);
 }
 

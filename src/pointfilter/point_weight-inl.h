@@ -1,5 +1,5 @@
-// pointfilter/point_weight-inl.h — PointFilterTable::weight on every lane of a Highway vector,
-// with weight()'s float operations (two gathers). Shared by the point setup
+// pointfilter/point_weight-inl.h — PointFilterWeight::weight on every lane of a Highway vector,
+// with weight()'s float operations. Shared by the point setup
 // (pointfilter/point_setup.cpp) and the point loop (composite/point_raster.cpp); included once
 // per SIMD target from inside their foreach_target.h passes (Highway's per-target include
 // guard), after <hwy/highway.h>. Compile the including file with -ffp-contract=off: the scalar
@@ -19,26 +19,30 @@ HWY_BEFORE_NAMESPACE();
 namespace vdbsplat {
 namespace HWY_NAMESPACE {
 
-/// PointFilterTable::weight on every lane: 0 where !(x < maxX) (NaN too); else the linear lookup.
+/// PointFilterWeight::weight on every lane: 0 where !(x < maxX) (NaN too); else 2^n·P(f), the
+/// scalar weight()'s products and sums in the same order (no MulAdd: the same floats on every target).
 template <class D, class V = hwy::HWY_NAMESPACE::Vec<D>>
-HWY_INLINE V PointWeight(D d, const PointFilterTable& table, V x) {
+HWY_INLINE V PointWeight(D d, const PointFilterWeight&, V x) {
     namespace hn = hwy::HWY_NAMESPACE;
     const hn::RebindToSigned<D> di;
-    const auto valid = hn::Lt(x, hn::Set(d, PointFilterTable::maxX()));  // false for NaN
-    const V t = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, table.indexScale()));
-    const auto k = hn::Min(hn::ConvertTo(di, t), hn::Set(di, PointFilterTable::kIntervals - 1));
-    const V w = hn::Sub(t, hn::ConvertTo(d, k));
-    const V v0 = hn::GatherIndex(d, table.values(), k), v1 = hn::GatherIndex(d, table.values() + 1, k);
-    return hn::IfThenElseZero(valid, hn::Add(v0, hn::Mul(w, hn::Sub(v1, v0))));
+    constexpr int kDegree = PointFilterWeight::kDegree;
+    const auto valid = hn::Lt(x, hn::Set(d, PointFilterWeight::maxX()));  // false for NaN
+    const V y = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, PointFilterWeight::kYPerX));
+    const V n = hn::Round(y);
+    const V f = hn::Sub(y, n);
+    V p = hn::Set(d, PointFilterWeight::kPow2[kDegree]);
+    for (int k = kDegree - 1; k >= 0; --k) p = hn::Add(hn::Mul(p, f), hn::Set(d, PointFilterWeight::kPow2[size_t(k)]));
+    const V scale = hn::BitCast(d, hn::ShiftLeft<23>(hn::Add(hn::ConvertTo(di, n), hn::Set(di, 127))));
+    return hn::IfThenElseZero(valid, hn::Mul(p, scale));
 }
 
 /// A point's eight columns from pixel @p firstX and eight rows from @p firstY, in one set of 16
-/// lanes (lanes 0–7 the columns, 8–15 the rows: one pair of gathers for a 16-lane target): each
+/// lanes (lanes 0–7 the columns, 8–15 the rows: one PointWeight for a 16-lane target): each
 /// pixel centre's squared offset from the point's centre (@p cx, @p cy), (i + ½) − c in float (one
 /// rounding of the exact difference, as the scalar setup's double difference rounded to float is),
 /// into @p sq, and its weight PointWeight(offset² / V) into @p g. The point setup and the point
 /// loops share it, so their weights are the same floats.
-HWY_INLINE void AxisWeights(const PointFilterTable& table, int firstX, int firstY, float cx, float cy, float invVariance,
+HWY_INLINE void AxisWeights(const PointFilterWeight& table, int firstX, int firstY, float cx, float cy, float invVariance,
                             float* HWY_RESTRICT sq, float* HWY_RESTRICT g) {
     namespace hn = hwy::HWY_NAMESPACE;
     const hn::CappedTag<float, 16> d;

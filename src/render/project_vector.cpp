@@ -239,7 +239,7 @@ void PointBoxes(const SplatLanes& L, PointLanes& P, size_t m, const PointLaneCon
 /// kPointMaxSide columns and rows (PointWeight), each column summed down its rows in order (a
 /// pixel outside the circle, a row past ny or a column past nx adding +0), then the columns
 /// pairwise (sumColumnsPairwise). Stores 1/sum as the norm, and the sum.
-void PointSums(PointLanes& P, size_t m, const PointFilterTable& table, float* sums) {
+void PointSums(PointLanes& P, size_t m, const PointFilterWeight& table, float* sums) {
     const hn::CappedTag<float, 16> d;  // at most 16 lanes: a whole number of them in m
     const hn::RebindToSigned<decltype(d)> di;
     using V = hn::Vec<decltype(d)>;

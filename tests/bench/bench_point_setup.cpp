@@ -30,9 +30,9 @@ const std::vector<Point>& points() {
     return p;
 }
 
-template <PointSetup (*Setup)(const PointFilterTable&, const PixelCoord&, double)>
+template <PointSetup (*Setup)(const PointFilterWeight&, const PixelCoord&, double)>
 void Run(benchmark::State& state) {
-    const PointFilterTable& table = standardPointFilterTable();
+    const PointFilterWeight& table = standardPointFilter();
     for (auto _ : state) {
         float sum = 0.0f;
         for (const Point& p : points()) sum += Setup(table, p.centre, p.variance).norm;

@@ -200,7 +200,7 @@ Image slowComposite(const std::vector<std::vector<Primitive>>& windows, int w, i
     Image image(w, h);
     std::vector<float> T(size_t(w) * h, 1.f);
     std::vector<glm::vec3> C(size_t(w) * h, glm::vec3(0.f));
-    const PointFilterTable filter;
+    const PointFilterWeight filter;
     for (const auto& prims : windows) {
         std::vector<size_t> order(prims.size());
         std::iota(order.begin(), order.end(), 0);

@@ -19,7 +19,7 @@ struct SlabArrays {
 };
 
 void vectorLoopEqualsTheScalarLoop() {
-    const PointFilterTable& table = standardPointFilterTable();
+    const PointFilterWeight& table = standardPointFilter();
     std::mt19937 rng(13);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     constexpr float kEpsilon = 1e-4f;

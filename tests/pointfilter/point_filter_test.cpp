@@ -15,6 +15,7 @@
 #include "footprint/tables.h"
 #include "pointfilter/point_filter.h"
 #include "render/project_modes.h"
+#include "support/targets.h"
 
 namespace vdbsplat {
 namespace {
@@ -33,16 +34,16 @@ TEST(PointFilter, VarianceIsPrefilterPlusProjectedFootprint) {
     EXPECT_NEAR(pointFilterVariance(0.5), kPrefilterVariance + 0.325 * 0.325, 1e-15);
 }
 
-TEST(PointFilter, TableMatchesTheGaussian) {
-    const PointFilterTable t;
-    EXPECT_LT(t.maxAbsError(), 5e-6);  // Δ²/8 · max|(e^{−x/2})″| with Δ = 9/1024
+TEST(PointFilter, WeightMatchesTheGaussian) {
+    const PointFilterWeight t;
+    EXPECT_LT(t.maxAbsError(), 5e-7);  // the series' remainder, 1.7e−7, and float roundings (1.6e−7 measured)
     EXPECT_FLOAT_EQ(t.weight(0.0f), 1.0f);
     EXPECT_EQ(t.weight(9.0f), 0.0f);
     EXPECT_EQ(t.weight(std::nanf("")), 0.0f);
 }
 
 TEST(PointFilter, WeightsSumToOneWithinSevenBySeven) {
-    const PointFilterTable t;
+    const PointFilterWeight t;
     for (double spacing : {0.0, 0.3, 0.7, 1.0, 1.5, 3.0})
         for (double fx = 0.0; fx < 1.0; fx += 0.125)
             for (double fy = 0.0; fy < 1.0; fy += 0.25) {
@@ -56,7 +57,7 @@ TEST(PointFilter, WeightsSumToOneWithinSevenBySeven) {
 }
 
 TEST(PointFilter, ShapeIsTheTruncatedGaussianAndSymmetric) {
-    const PointFilterTable t;
+    const PointFilterWeight t;
     const double V = pointFilterVariance(1.0);
     const PointFootprint fp = rasterizePoint(t, {10.5, 20.5}, V);  // at a pixel centre
     ASSERT_EQ(fp.nx, 7);
@@ -94,7 +95,7 @@ struct Energy {
     double splatTable = 0.0, splatExact = 0.0, point = 0.0, maxPixelDiff = 0.0, peak = 0.0;
 };
 
-Energy energyAt(const Tables& tables, const PointFilterTable& pft, const EnergyCase& ec, double spacingPx) {
+Energy energyAt(const Tables& tables, const PointFilterWeight& pft, const EnergyCase& ec, double spacingPx) {
     const double f = 500.0, sigma = 2.0, z = 10.0, h = spacingPx * z / f;
     const PixelCoord pp(200.0 + ec.subX, 200.0 + ec.subY);
     const double t = std::tan(ec.thetaDeg * kDeg);
@@ -126,7 +127,7 @@ Energy energyAt(const Tables& tables, const PointFilterTable& pft, const EnergyC
 
 TEST(PointFilterEnergy, SplatEqualsPointAtTheThresholdWithinOnePercent) {
     const Tables tables = buildTables();
-    const PointFilterTable pft;
+    const PointFilterWeight pft;
     const EnergyCase cases[] = {{0.0, 0.0, 0.0, 0.0},   {0.0, 0.0, 0.37, 0.81}, {0.0, 0.0, 0.5, 0.5},
                                 {10.0, 30.0, 0.2, 0.6}, {20.0, 120.0, 0.9, 0.1}, {35.0, 250.0, 0.45, 0.3}};
     std::printf("energy at the threshold (h f/z = 1 px): splat/point (table, exact), max pixel diff / peak\n");
@@ -147,7 +148,7 @@ TEST(PointFilterEnergy, SplatEqualsPointAtTheThresholdWithinOnePercent) {
 TEST(PointFilterEnergy, EnergyMatchesAcrossScales) {
     // Away from the threshold the two paths still carry the same total (zoom does not pop).
     const Tables tables = buildTables();
-    const PointFilterTable pft;
+    const PointFilterWeight pft;
     for (double spacing : {0.5, 0.8, 1.25, 2.0}) {
         const Energy e = energyAt(tables, pft, {15.0, 60.0, 0.3, 0.7}, spacing);
         EXPECT_NEAR(e.splatTable / e.point, 1.0, 0.01) << "spacing " << spacing;
@@ -155,7 +156,7 @@ TEST(PointFilterEnergy, EnergyMatchesAcrossScales) {
 }
 
 TEST(PointFilter, NonFiniteInputGivesNoPixels) {
-    const PointFilterTable t;
+    const PointFilterWeight t;
     EXPECT_EQ(rasterizePoint(t, {std::nan(""), 1.0}, 1.5).nx, 0);
     EXPECT_EQ(rasterizePoint(t, {1e300, 1.0}, 1.5).nx, 0);
 }
@@ -165,7 +166,7 @@ TEST(PointFilter, NonFiniteInputGivesNoPixels) {
 // on pixel centres and edges, variances from --mode none's 1/36 to the 3.5 px cap, and ones so
 // small that no pixel centre lies within r_s (rasterizePoint's one-pixel fallback).
 TEST(PointFilter, SetupMatchesTheFootprint) {
-    const PointFilterTable& t = standardPointFilterTable();
+    const PointFilterWeight& t = standardPointFilter();
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     int checked = 0, fallbacks = 0;
@@ -198,8 +199,8 @@ TEST(PointFilter, SetupMatchesTheFootprint) {
 // The vector setup (setupPointVector: both axes' weights in one vector, the terms row by row in
 // vectors, the sum in the scalar order) is the scalar setup bit for bit, for float centres (what
 // the renderer stores), including centres at and near 0, past the image's edges, and the fallback.
-TEST(PointFilter, VectorSetupEqualsTheScalarSetup) {
-    const PointFilterTable& t = standardPointFilterTable();
+void vectorSetupEqualsTheScalarSetup() {
+    const PointFilterWeight& t = standardPointFilter();
     std::mt19937 rng(9);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     int fallbacks = 0;
@@ -224,6 +225,9 @@ TEST(PointFilter, VectorSetupEqualsTheScalarSetup) {
     EXPECT_GT(fallbacks, 100);
     EXPECT_TRUE(setupPointVector(t, {std::nan(""), 1.0}, 1.5).empty());
 }
+
+// On every SIMD target the binary holds (the weight's float steps must agree on each).
+TEST(PointFilter, VectorSetupEqualsTheScalarSetup) { test::forEachTarget([] { vectorSetupEqualsTheScalarSetup(); }); }
 
 }  // namespace
 }  // namespace vdbsplat
