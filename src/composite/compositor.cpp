@@ -456,14 +456,14 @@ void TileCompositor::compositeTile(int tile, std::span<const Entry> entries) {
         const TileRecord& p = window_->records[i];
         const bool isPoint = p.kind == PrimitiveKind::Point;
         if (int64_t(p.slab) != slabOf || !isPoint) {
-            compositeSlab(px, slab);
+            closeSlab(px, slab, false);
             slabOf = p.slab;
         }
         // Tile-level early termination, checked every 32 primitives.
         if ((e & 31) == 31 && !slab.dirty && !px.anyLive()) break;
         drawPrimitive(p, i, px, &slab, nullptr);
     }
-    compositeSlab(px, slab);
+    closeSlab(px, slab, false);
     storeTile(tile, px);
 }
 
@@ -480,7 +480,7 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const Entry> entries
     const auto closeUpTo = [&](int64_t end) {  // composites the open slabs before `end`
         if (ring.first >= end) return;
         if (ring.open())
-            for (int64_t s = ring.first; s < end && s <= ring.last; ++s) closeSlab(px, ring.at(s));
+            for (int64_t s = ring.first; s < end && s <= ring.last; ++s) closeSlab(px, ring.at(s), true);
         ring.first = end;
     };
     const int64_t base = window_->slabBase;
@@ -506,13 +506,20 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const Entry> entries
     if (opaque) owned.reset();
 }
 
-void TileCompositor::closeSlab(TilePixels& px, SlabBuffer& slab) const {
+void TileCompositor::closeSlab(TilePixels& px, SlabBuffer& slab, bool skipFinished) const {
     if (!slab.dirty) return;
     if (!exact_.vector) {
-        compositeSlab(px, slab, true);
+        compositeSlab(px, slab, skipFinished);
         return;
     }
-    compositeSlabVector(slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.buffers(), kTransmittanceEpsilon);
+    // The vector loop skips finished pixels too: in the kernel order there are none among a
+    // slab's deposits (its points drew only live pixels, and nothing drew in between).
+    TileRect rect;
+    if (slab.x1 >= slab.x0)
+        rect = {std::max(px.x0, slab.x0) - px.x0, std::max(px.y0, slab.y0) - px.y0, std::min(px.x1, slab.x1) - px.x0,
+                std::min(px.y1, slab.y1) - px.y0};
+    slab.x0 = 0, slab.y0 = 0, slab.x1 = -1, slab.y1 = -1;
+    compositeSlabVector(slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.buffers(), kTransmittanceEpsilon, rect);
     slab.dirty = false;
 }
 
@@ -525,7 +532,7 @@ void TileCompositor::finish() {
             if (ring->open()) {
                 TilePixels px;
                 loadTile(tile, px);
-                for (int64_t s = ring->first; s <= ring->last; ++s) closeSlab(px, ring->at(s));
+                for (int64_t s = ring->first; s <= ring->last; ++s) closeSlab(px, ring->at(s), true);
                 storeTile(tile, px);
             }
             ring.reset();

@@ -159,7 +159,9 @@ private:
     [[gnu::always_inline]] inline void prefetchAhead(std::span<const Entry> entries, size_t e, bool profiles) const;
     void compositeTile(int tile, std::span<const Entry> entries);
     void compositeTileSlabs(int tile, std::span<const Entry> entries, int64_t closeBefore);
-    void closeSlab(TilePixels& px, SlabBuffer& slab) const;  // one "over" per live pixel, then empty
+    /// One "over" per pixel the slab deposited into (live ones only with @p skipFinished; the vector
+    /// loop skips finished pixels always), then empty: over its tracked rectangle, else the tile.
+    void closeSlab(TilePixels& px, SlabBuffer& slab, bool skipFinished) const;
     void drawPrimitive(const TileRecord& p, uint32_t i, TilePixels& px, SlabBuffer* slab, const SlabTargets* slabs) const;
     void drawPoint(const TileRecord& p, const TilePixels& tile, SlabBuffer* slab, const SlabTargets* slabs) const;
     void drawSplat(const TileRecord& p, const ExactIndexMap& map, TilePixels& tile, const SlabTargets* slabs) const;

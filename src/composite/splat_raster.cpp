@@ -408,26 +408,29 @@ void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) {
     DrawSplatRowsFor<false>(hn::CappedTag<float, kPairLanes>(), s, tile);
 }
 
-/// One slab over the tile's live pixels, then emptied (compositeSlabVector).
-void CompositeSlab(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon) {
+/// One slab over the live pixels of the tile's rectangle, then emptied there (compositeSlabVector):
+/// each row's vectors from the one holding the rectangle's first column (row starts are aligned).
+void CompositeSlab(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon, TileRect rect) {
     const hn::CappedTag<float, kStride> d;
     using V = hn::Vec<decltype(d)>;
     const int n = int(hn::Lanes(d));
     const V zero = hn::Zero(d), eps = hn::Set(d, epsilon);
-    for (int i = 0; i < kStride * kStride; i += n) {
-        const V t = hn::Load(d, tau + i);
-        const V T = hn::Load(d, tile.T + i);
-        const auto mask = hn::And(hn::Gt(t, zero), hn::Ge(T, eps));
-        if (!hn::AllFalse(d, mask)) {
-            const V ta = hn::Mul(T, OpacityFromTau(d, t));  // T·α
-            const V w = hn::IfThenElseZero(mask, hn::Div(ta, hn::IfThenElse(mask, t, hn::Set(d, 1.f))));
-            hn::Store(hn::MulAdd(w, hn::Load(d, er + i), hn::Load(d, tile.R + i)), d, tile.R + i);
-            hn::Store(hn::MulAdd(w, hn::Load(d, eg + i), hn::Load(d, tile.G + i)), d, tile.G + i);
-            hn::Store(hn::MulAdd(w, hn::Load(d, eb + i), hn::Load(d, tile.B + i)), d, tile.B + i);
-            hn::Store(hn::IfThenElse(mask, hn::Sub(T, ta), T), d, tile.T + i);
+    const int first = rect.x0 / n * n;
+    for (int y = rect.y0; y <= rect.y1; ++y)
+        for (int i = y * kStride + first, end = y * kStride + rect.x1; i <= end; i += n) {
+            const V t = hn::Load(d, tau + i);
+            const V T = hn::Load(d, tile.T + i);
+            const auto mask = hn::And(hn::Gt(t, zero), hn::Ge(T, eps));
+            if (!hn::AllFalse(d, mask)) {
+                const V ta = hn::Mul(T, OpacityFromTau(d, t));  // T·α
+                const V w = hn::IfThenElseZero(mask, hn::Div(ta, hn::IfThenElse(mask, t, hn::Set(d, 1.f))));
+                hn::Store(hn::MulAdd(w, hn::Load(d, er + i), hn::Load(d, tile.R + i)), d, tile.R + i);
+                hn::Store(hn::MulAdd(w, hn::Load(d, eg + i), hn::Load(d, tile.G + i)), d, tile.G + i);
+                hn::Store(hn::MulAdd(w, hn::Load(d, eb + i), hn::Load(d, tile.B + i)), d, tile.B + i);
+                hn::Store(hn::IfThenElse(mask, hn::Sub(T, ta), T), d, tile.T + i);
+            }
+            hn::Store(zero, d, tau + i), hn::Store(zero, d, er + i), hn::Store(zero, d, eg + i), hn::Store(zero, d, eb + i);
         }
-        hn::Store(zero, d, tau + i), hn::Store(zero, d, er + i), hn::Store(zero, d, eg + i), hn::Store(zero, d, eb + i);
-    }
 }
 
 }  // namespace HWY_NAMESPACE
@@ -440,8 +443,8 @@ namespace vdbsplat {
 HWY_EXPORT(DrawSplatRows);
 HWY_EXPORT(CompositeSlab);
 
-void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon) {
-    HWY_DYNAMIC_DISPATCH(CompositeSlab)(tau, er, eg, eb, tile, epsilon);
+void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon, TileRect rect) {
+    HWY_DYNAMIC_DISPATCH(CompositeSlab)(tau, er, eg, eb, tile, epsilon, rect);
 }
 
 void drawSplatVector(const SplatRaster& s, const TileBuffers& tile) { HWY_DYNAMIC_DISPATCH(DrawSplatRows)(s, tile); }

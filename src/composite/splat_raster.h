@@ -67,10 +67,17 @@ struct SplatRaster {
 /// @brief Composites @p s "over" the pixels of @p tile (front to back).
 void drawSplatVector(const SplatRaster& s, const TileBuffers& tile);
 
-/// @brief --compositing slabs: composites one slab of a tile (optical depth @p tau and σ-weighted
-/// emission @p er, @p eg, @p eb, kTilePixels each) onto @p tile's live pixels (T ≥ @p epsilon):
-/// α = 1 − e^{−τ}, C += T·α·e/τ, T *= 1 − α; then empties the slab. Vectorised (Highway).
-void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon);
+/// @brief A slab's sums in the tile's pixels @p rect (both orders: the points' slabs of the kernel
+/// order, every slab of --compositing slabs): the optical depth @p tau and σ-weighted emission
+/// @p er, @p eg, @p eb (kTilePixels each) composited onto @p tile's live pixels (T ≥ @p epsilon),
+/// α = 1 − e^{−τ}, C += T·α·e/τ, T *= 1 − α; then the slab emptied there. The rectangle's columns
+/// are read in whole vectors: every pixel outside it must hold τ = 0 (it is left unchanged then).
+/// Vectorised (Highway).
+struct TileRect {
+    int x0 = 0, y0 = 0, x1 = kTileSize - 1, y1 = kTileSize - 1;  ///< inclusive, tile-local; default: the whole tile
+};
+void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon,
+                         TileRect rect = {});
 
 /// @brief The same loop one pixel at a time, in the same float operations (tests: the vector
 /// loop must agree with it to float rounding).

@@ -186,11 +186,14 @@ TEST(SlabCompositing, EveryForwardModeTakesIt) {
     }
 }
 
-// The scalar table path (--simd off) is the oracle of the vector loops in the slab order too.
+// The scalar table path (--simd off) is the oracle of the vector loops in both orders: the
+// splats, and the points' slabs (in the kernel order composited over the rectangle their points
+// touched, compositeSlabVector's TileRect), near and far.
 TEST(SlabCompositing, VectorLoopsMatchTheScalarPaths) {
     const TransferFunction tf = TransferFunction::preset("grey");
-    for (const double distance : {0.35, 1.0, 3.0}) {
-        RenderSettings s = withOrder(settingsFor(RenderMode::Hybrid, distance), CompositingOrder::Slabs);
+    for (const CompositingOrder order : {CompositingOrder::Kernels, CompositingOrder::Slabs})
+    for (const double distance : {0.35, 1.0, 3.0, 8.0}) {
+        RenderSettings s = withOrder(settingsFor(RenderMode::Hybrid, distance), order);
         const Image vector = renderWith(marschnerLobb(), tf, s);
         s.simd = false;
         const Image scalar = renderWith(marschnerLobb(), tf, s);
