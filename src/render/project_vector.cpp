@@ -250,6 +250,9 @@ void PointSums(PointLanes& P, size_t m, const PointFilterWeight& table, float* s
         const V invV = hn::Load(d, P.invVariance + i), rs2 = hn::Load(d, P.radius2 + i);
         const auto x0 = hn::Load(di, P.x0 + i), y0 = hn::Load(di, P.y0 + i);
         const auto nx = hn::Load(di, P.nx + i), ny = hn::Load(di, P.ny + i);
+        // A column past nx or a row past ny gets the squared offset +∞ (after its weight), so that
+        // the circle's test dx² + dy² < r_s² alone leaves it out: one mask per term.
+        const V outside = hn::Inf(d);
         V dx2[kPointMaxSide], gx[kPointMaxSide], dy2[kPointMaxSide], gy[kPointMaxSide];
         for (int k = 0; k < kPointMaxSide; ++k) {
             // (i + ½) − c in float: one rounding of the exact difference (PointSetup::offset).
@@ -258,15 +261,15 @@ void PointSums(PointLanes& P, size_t m, const PointFilterWeight& table, float* s
             dx2[k] = hn::Mul(ox, ox), dy2[k] = hn::Mul(oy, oy);
             gx[k] = PointWeight(d, table, hn::Mul(dx2[k], invV));
             gy[k] = PointWeight(d, table, hn::Mul(dy2[k], invV));
+            dx2[k] = hn::IfThenElse(hn::RebindMask(d, hn::Lt(hn::Set(di, k), nx)), dx2[k], outside);
+            dy2[k] = hn::IfThenElse(hn::RebindMask(d, hn::Lt(hn::Set(di, k), ny)), dy2[k], outside);
         }
         V columns[kPointSumColumns];
         for (int ix = 0; ix < kPointSumColumns; ++ix) {
             columns[ix] = zero;
             if (ix >= kPointMaxSide) continue;
-            const auto column = hn::RebindMask(d, hn::Lt(hn::Set(di, ix), nx));
             for (int iy = 0; iy < kPointMaxSide; ++iy) {
-                const auto in = hn::And(hn::And(column, hn::RebindMask(d, hn::Lt(hn::Set(di, iy), ny))),
-                                        hn::Lt(hn::Add(dx2[ix], dy2[iy]), rs2));
+                const auto in = hn::Lt(hn::Add(dx2[ix], dy2[iy]), rs2);
                 columns[ix] = hn::Add(columns[ix], hn::IfThenElseZero(in, hn::Mul(gx[ix], gy[iy])));
             }
         }
