@@ -67,15 +67,17 @@ struct SplatRaster {
 /// @brief Composites @p s "over" the pixels of @p tile (front to back).
 void drawSplatVector(const SplatRaster& s, const TileBuffers& tile);
 
+/// @brief Pixels of a tile, inclusive and tile-local (column x0 … x1 of rows y0 … y1); by default all.
+struct TileRect {
+    int x0 = 0, y0 = 0, x1 = kTileSize - 1, y1 = kTileSize - 1;
+};
+
 /// @brief A slab's sums in the tile's pixels @p rect (both orders: the points' slabs of the kernel
 /// order, every slab of --compositing slabs): the optical depth @p tau and σ-weighted emission
 /// @p er, @p eg, @p eb (kTilePixels each) composited onto @p tile's live pixels (T ≥ @p epsilon),
 /// α = 1 − e^{−τ}, C += T·α·e/τ, T *= 1 − α; then the slab emptied there. The rectangle's columns
 /// are read in whole vectors: every pixel outside it must hold τ = 0 (it is left unchanged then).
 /// Vectorised (Highway).
-struct TileRect {
-    int x0 = 0, y0 = 0, x1 = kTileSize - 1, y1 = kTileSize - 1;  ///< inclusive, tile-local; default: the whole tile
-};
 void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon,
                          TileRect rect = {});
 

@@ -54,9 +54,11 @@ double pointDepositTotal(double sigma, double h, double f, const ViewPoint& c);
 /// 2^n an exact power of two. Every step is one float product or sum (no fused multiply-add), so
 /// the scalar weight() and the vector one (point_weight-inl.h) give the same floats on every SIMD
 /// target. Error: the series' remainder (ln 2/2)⁷/7!·2^½ < 1.7e−7 of 2^f, plus a few float
-/// roundings: |weight − exp(−x/2)| < 5e−7 (PointFilter.WeightMatchesTheGaussian; 1.6e−7 measured). Until session 27 a
-/// 1 024-interval table with linear lookups (2.4e−6), whose two gathers per vector of weights were
-/// the far views' point set-up's largest cost.
+/// roundings: |weight − exp(−x/2)| < 5e−7 (PointFilter.WeightMatchesTheGaussian; 1.6e−7
+/// measured). Until session 27 a 1 024-interval table with linear lookups (2.4e−6), whose two
+/// gathers per vector of weights were the far views' point set-up's largest cost. (Files that
+/// evaluate it in vectors are built with -ffp-contract=off, CMakeLists.txt; elsewhere the scalar
+/// form is compiled for the baseline x86-64, which has no fused multiply-add to contract to.)
 class PointFilterWeight {
 public:
     static constexpr double kMaxX = kPointSupportSigmas * kPointSupportSigmas;

@@ -28,7 +28,7 @@ namespace vdbsplat {
 
 namespace {
 constexpr int kBlockDim = 8;  // OpenVDB leaf side; active tiles are split into blocks of this side
-static const size_t kMaxWindowBlocks = std::getenv("VDBSPLAT_MWB") ? size_t(std::atoi(std::getenv("VDBSPLAT_MWB"))) : 512;  // a window grows past its slabs up to this many blocks (recordsOf)
+constexpr size_t kMaxWindowBlocks = 512;  // a window grows past its slabs up to this many blocks (recordsOf)
 constexpr size_t kExtractChunk = 16;      // blocks extracted into one buffer, in order (VoxelStream::next)
 constexpr uint64_t kMaxActiveVoxels = uint64_t(1) << 32;
 }  // namespace
