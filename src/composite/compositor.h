@@ -48,7 +48,7 @@ struct ExactContext {
     bool vector = true;
     /// The low-pass folded into kernels recomputed per tile, by their projected spacing (px²; as
     /// ProjectionContext::lowPass).
-    PrefilterRamp lowPass;
+    PrefilterRamp lowPass{};
     /// The kernels' shape in view space (footprint/ellipsoid.h); null or a sphere: spheres.
     /// Ellipsoid kernels at the eye (NearEye) take the exact index-space half-ray integral.
     const VoxelShape* shape = nullptr;

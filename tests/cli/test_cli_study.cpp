@@ -342,7 +342,7 @@ TEST_F(StudyCli, KilledHardKeepsFinishedRendersAndResumeCleansUp) {
         const std::string stem = p.substr(0, p.size() - 5);
         EXPECT_EQ(readImage(stem + ".exr").width, 24) << stem;
         EXPECT_EQ(readImage(stem + ".png").width, 24) << stem;
-        EXPECT_NO_THROW((void)nlohmann::json::parse(slurp(p))) << p;
+        EXPECT_TRUE(nlohmann::json::accept(slurp(p))) << p;  // parses as JSON
     }
     EXPECT_GE(finished, 3u);
     const CliResult resumed = test::runVdbsplat(
