@@ -83,6 +83,15 @@ struct TileCompositor::SlabBuffer {
         }
         x0 = std::min(x0, ax0), y0 = std::min(y0, ay0), x1 = std::max(x1, ax1), y1 = std::max(y1, ay1);
     }
+    /// The tile pixels to composite (tile-local: the tracked pixels inside the tile @p px0 … @p px1,
+    /// or all of its image pixels), and the tracking cleared for the next slab.
+    TileRect take(int px0, int py0, int px1, int py1) {
+        const bool tracked = x1 >= x0;
+        const TileRect r{(tracked ? std::max(px0, x0) : px0) - px0, (tracked ? std::max(py0, y0) : py0) - py0,
+                         (tracked ? std::min(px1, x1) : px1) - px0, (tracked ? std::min(py1, y1) : py1) - py0};
+        x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+        return r;
+    }
 };
 
 /// --compositing slabs: one tile's open slabs [first, last] (last < first: none), slab s in
@@ -395,13 +404,10 @@ template <class Pixels, class Slab>
 void compositeSlab(Pixels& px, Slab& slab, bool skipFinished = false) {
     if (!slab.dirty) return;
     // Only where deposits were made, when known (elsewhere τ = 0: nothing to composite or clear).
-    const bool tracked = slab.x1 >= slab.x0;
-    const int xa = tracked ? std::max(px.x0, slab.x0) : px.x0, xb = tracked ? std::min(px.x1, slab.x1) : px.x1;
-    const int ya = tracked ? std::max(px.y0, slab.y0) : px.y0, yb = tracked ? std::min(px.y1, slab.y1) : px.y1;
-    slab.x0 = 0, slab.y0 = 0, slab.x1 = -1, slab.y1 = -1;
-    for (int y = ya; y <= yb; ++y)
-        for (int x = xa; x <= xb; ++x) {
-            const int i = px.local(x, y);
+    const TileRect r = slab.take(px.x0, px.y0, px.x1, px.y1);
+    for (int y = r.y0; y <= r.y1; ++y)
+        for (int x = r.x0; x <= r.x1; ++x) {
+            const int i = y * kTileSize + x;
             const size_t j = size_t(i);
             const float tau = slab.tau[j];
             if (tau > 0.f && (!skipFinished || px.live(i))) px.over(i, tau, glm::vec3(slab.er[j], slab.eg[j], slab.eb[j]) / tau);
@@ -514,12 +520,8 @@ void TileCompositor::closeSlab(TilePixels& px, SlabBuffer& slab, bool skipFinish
     }
     // The vector loop skips finished pixels too: in the kernel order there are none among a
     // slab's deposits (its points drew only live pixels, and nothing drew in between).
-    TileRect rect;
-    if (slab.x1 >= slab.x0)
-        rect = {std::max(px.x0, slab.x0) - px.x0, std::max(px.y0, slab.y0) - px.y0, std::min(px.x1, slab.x1) - px.x0,
-                std::min(px.y1, slab.y1) - px.y0};
-    slab.x0 = 0, slab.y0 = 0, slab.x1 = -1, slab.y1 = -1;
-    compositeSlabVector(slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.buffers(), kTransmittanceEpsilon, rect);
+    compositeSlabVector(slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.buffers(), kTransmittanceEpsilon,
+                        slab.take(px.x0, px.y0, px.x1, px.y1));
     slab.dirty = false;
 }
 
