@@ -363,6 +363,13 @@ PackedCells cellsWithMass(const CellMoments* cells, int count) {
     return {cells, mask, false};
 }
 
+/// Cell @p i of a block's (8 >> @p level)³ cells at (cx·c + cy)·c + cz, as (cx, cy, cz): by shifts
+/// (three integer divisions by the cell count were most of a warm far render's cell records).
+glm::ivec3 cellOf(int i, int level) {
+    const int bits = 3 - level, mask = (1 << bits) - 1;
+    return {i >> (2 * bits), (i >> bits) & mask, i & mask};
+}
+
 /// Room for a block's cells at any level (≤ (8/2)³), left unzeroed (CellMoments zeroes itself).
 struct MomentScratch {
     union {
@@ -419,7 +426,8 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts,
     std::fill_n(up, parents * parents * parents, CellMoments{});
     int j = 0;
     for (uint64_t bits = fine.mask; bits != 0; bits &= bits - 1, ++j) {
-        const int i = std::countr_zero(bits), cx = i / (cells * cells), cy = (i / cells) % cells, cz = i % cells;
+        const int i = std::countr_zero(bits);
+        const auto [cx, cy, cz] = cellOf(i, level);
         const CellMoments& a = fine.at(i, j);
         CellMoments& p = up[size_t(((cx >> 1) * parents + (cy >> 1)) * parents + (cz >> 1))];
         const glm::vec3 o = (glm::vec3(float(cx & 1), float(cy & 1), float(cz & 1)) - 0.5f) * childSide;
@@ -645,7 +653,7 @@ void VoxelStream::computeCellMoments(const Block& b, int level, CellMoments* acc
 // (fineSide: < ½). nullptr: weight 1, counted.
 void VoxelStream::emitCells(const Block& b, int level, PackedCells acc, const float* coarse, bool fineSide,
                             VoxelBatch& out, StreamCounts& counts) const {
-    const int side = 1 << level, cells = b.dim >> level;
+    const int side = 1 << level;
     // In float about the block: its first cell's centre in view space once (double, as every
     // record's position), then per cell offsets of at most 8 voxels through the linear part A. (In
     // double throughout, the cells' conversions and divisions were 12 % of a far render's CPU.)
@@ -686,7 +694,8 @@ void VoxelStream::emitCells(const Block& b, int level, PackedCells acc, const fl
     };
     int j = 0;
     for (uint64_t bits = acc.mask; bits != 0; bits &= bits - 1) {
-        const int i = std::countr_zero(bits), cx = i / (cells * cells), cy = (i / cells) % cells, cz = i % cells;
+        const int i = std::countr_zero(bits);
+        const auto [cx, cy, cz] = cellOf(i, level);
         const CellMoments& a = acc.at(i, j++);
         if (!(a.m > 0.f)) continue;
         const float c = coarse ? coarse[size_t(i)] : 1.f;
