@@ -334,5 +334,27 @@ TEST(Image, WritesThroughASymbolicLinkAndRefusesAFifo) {
     test::expectNoTemporaries(dir.dir());
 }
 
+// A new Image is transparent everywhere, also where its memory was another image's a moment ago:
+// small images (calloc) and large ones (mapped pages, ZeroedAllocator::kMapBytes and more), one
+// after another as bench and animate make them, each written whole before it goes.
+TEST(Image, EveryNewImageIsTransparentAlsoAfterAnotherWasWritten) {
+    for (const int side : {16, 300, 1024}) {
+        for (int round = 0; round < 3; ++round) {
+            Image image(side, side);
+            ASSERT_EQ(image.pixels.size(), size_t(side) * size_t(side));
+            size_t nonZero = 0;
+            for (const glm::vec4& p : image.pixels) nonZero += p != glm::vec4(0.f);
+            EXPECT_EQ(nonZero, 0u) << side << "² image, round " << round;
+            std::fill(image.pixels.begin(), image.pixels.end(), glm::vec4(0.25f, 0.5f, 0.75f, 1.f));
+        }
+    }
+    // A copy is the copy, not zeros (the allocator's construct leaves only default-constructed
+    // elements alone).
+    Image a(512, 512);
+    a.at(7, 9) = glm::vec4(1.f, 2.f, 3.f, 4.f);
+    const Image b = a;
+    EXPECT_EQ(b.at(7, 9), glm::vec4(1.f, 2.f, 3.f, 4.f));
+}
+
 }  // namespace
 }  // namespace vdbsplat
