@@ -17,9 +17,11 @@
 #include "cli/render_flags.h"
 #include "volume/emission.h"
 #include "image/image.h"
+#include "render/forward_buffers.h"
 #include "render/render.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/parse.h"
 
 namespace vdbsplat::cli {
 
@@ -65,6 +67,9 @@ void declareRender(CLI::App& app) {
                                     "RGBA + metadata)")
         ->required();
     addValueFlag(app, "--stats", "FILE.json", "write settings, timings and primitive counts as JSON");
+    addValueFlag(app, "--warmup", "N", "render the view N times untimed first, keeping buffers, as bench,\n"
+                                       "animate and an interactive viewer do; --stats and -v then time\n"
+                                       "the last render alone (0..100, default 0: a cold, one-shot render)");
     addSwitch(app, "-v", "show progress on stderr (a bar with ETA on a terminal, a line per\n"
                          "10% otherwise) and print the statistics in one line at the end");
     addRenderFlags(app);
@@ -73,12 +78,17 @@ void declareRender(CLI::App& app) {
         "(reference): nothing is written, exit 1. A second one stops at once.");
 }
 
+namespace {
+constexpr int kMaxRenderWarmup = 100;
+}  // namespace
+
 int runRender(const Args& args) {
     const std::string input = args.onePositional("input .vdb file");
     const std::string output = args.require("-o");
     RenderSettings settings = settingsFromFlags(args);
     checkImagePath(output);
     checkNotAnInput(output, input, "-o");
+    const int warmup = args.has("--warmup") ? int(parseInt(*args.get("--warmup"), "--warmup", 0, kMaxRenderWarmup)) : 0;
     const auto statsPath = args.get("--stats");
     if (statsPath) checkStatsPath(*statsPath, output), checkNotAnInput(*statsPath, input, "--stats");
 
@@ -103,7 +113,15 @@ int runRender(const Args& args) {
         control.progress = [&meter](double f) { meter->update(f); };
     }
     Image image;
+    ForwardBuffers buffers;  // kept between the warm-up renders and the timed one
+    if (warmup > 0) control.buffers = &buffers;
     try {
+        for (int i = 0; i < warmup; ++i) {
+            RenderStats untimed;
+            RenderControl quiet = control;
+            quiet.progress = nullptr;
+            (void)render(volume, tf, settings, untimed, quiet);
+        }
         image = render(volume, tf, settings, stats, control);
     } catch (const RenderStopped&) {
         throw Error("render interrupted by " + guard.signalName() + "; " + output + " not written");
@@ -115,6 +133,7 @@ int runRender(const Args& args) {
     meta["width"] = camera.width();
     meta["height"] = camera.height();
     meta["input"] = input;
+    meta["warmup"] = warmup;
     meta["grid"] = volume.name;
     meta["camera"] = camera.describe();
     meta["transfer_function"] = nlohmann::json::parse(tf.toJson());

@@ -287,6 +287,9 @@ TEST_F(CliRender, BadFlagValues) {
         {s, {"--threshold", "0"}, "--threshold", kAllModes, kParsing},
         {s, {"--threshold", "-1"}, "--threshold", kAllModes, kParsing},
         {s, {"--footprint", "bogus"}, "--footprint", kAllModes, kParsing},
+        {s, {"--warmup", "101"}, "--warmup: expected an integer in [0, 100], got '101'", kAllModes, kParsing},
+        {s, {"--warmup", "-1"}, "--warmup", kAllModes, kParsing},
+        {s, {"--warmup", "two"}, "--warmup", kAllModes, kParsing},
         {s, {"--stats", (shared_ / "no" / "such" / "s.json").string()}, "--stats", kAllModes, kParsing},
         {s, {"--tables", tables("t_nowhere")}, "--tables: " + tables("t_nowhere") + ": no such directory", kAllModes, kParsing},
         {s, {"--tables", s}, "--tables: " + s + ": not a directory", kAllModes, kParsing},
@@ -599,6 +602,35 @@ TEST_F(CliRender, ImageIndependentOfThreadsAndOfTablesSource) {
     const std::string first = slurp(outs[0]);
     ASSERT_GT(first.size(), 100u);
     for (size_t i = 1; i < variants.size(); ++i) EXPECT_TRUE(slurp(outs[i]) == first) << variants[i].first << " differs";
+}
+
+// --warmup N renders the view N times first with buffers (and level-of-detail moments) kept, as
+// bench and animate do, and times the last render: the image is the cold render's, bit for bit,
+// and the stats say how many renders came before. A far view, so the kept moments are read back.
+TEST_F(CliRender, WarmRenderEqualsTheColdOneAndSaysSo) {
+    const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
+        {"cold", {}}, {"warm", {"--warmup", "2"}}};
+    std::vector<fs::path> outs, stats;
+    std::vector<std::vector<std::string>> args;
+    for (const auto& [name, flags] : variants) {
+        const fs::path d = runDir(name);
+        outs.push_back(d / "out" / "img.exr"), stats.push_back(d / "out" / "s.json");
+        std::vector<std::string> f = flags;
+        f.insert(f.end(), {"--size", "48x48", "--distance", "6", "--stats", stats.back().string()});
+        args.push_back(renderArgs(vdb("sphere.vdb"), outs.back().string(), "hybrid", f));
+    }
+    std::vector<Result> results(variants.size());
+    parallelFor(variants.size(), [&](size_t i) { results[i] = runBinary(args[i], outs[i].parent_path().parent_path() / "log"); });
+    for (size_t i = 0; i < variants.size(); ++i) ASSERT_EQ(results[i].rc, 0) << variants[i].first << ": " << results[i].err;
+    const Image cold = readImage(outs[0].string()), warm = readImage(outs[1].string());
+    ASSERT_EQ(cold.pixels.size(), warm.pixels.size());
+    EXPECT_TRUE(std::equal(cold.pixels.begin(), cold.pixels.end(), warm.pixels.begin())) << "the warm render differs";
+    const nlohmann::json c = nlohmann::json::parse(slurp(stats[0])), w = nlohmann::json::parse(slurp(stats[1]));
+    EXPECT_EQ(c["warmup"], 0);
+    EXPECT_EQ(w["warmup"], 2);
+    EXPECT_GT(w["lod_aggregates"].get<double>(), 0.0) << "a far view: the kept moments are used";
+    EXPECT_EQ(w["points"], c["points"]);
+    EXPECT_EQ(w["culled"], c["culled"]);
 }
 
 }  // namespace
