@@ -551,7 +551,6 @@ void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBu
     r.x0 = std::max(p.range.x0, px.x0), r.x1 = std::min(p.range.x1, px.x1);
     r.y0 = std::max(p.range.y0, px.y0), r.y1 = std::min(p.range.y1, px.y1);
     r.epsilon = kTransmittanceEpsilon;
-    r.table = &standardPointFilter();
     if (slabs) {
         exact_.vector ? drawPointSlabsVector(r, *slabs, px.T.data(), px.x0, px.y0)
                       : drawPointSlabsScalar(r, *slabs, px.T.data(), px.x0, px.y0);

@@ -30,14 +30,13 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTargets* slabs, const Sla
     using V = hn::Vec<D>;
     constexpr int N = int(hn::MaxLanes(D()));
     const hn::RebindToSigned<D> di;
-    const PointFilterWeight& table = *p.table;
     // The tile's columns in vectors of N: the first and last that hold footprint pixels.
     const int c0 = (p.x0 - tileX0) / N * N, c1 = (p.x1 - tileX0) / N * N;
     // Per column and per row of the footprint's part in the tile (once per point and tile): the
     // squared offset and its weight, both axes in one vector of 16 (lanes 0–7 the columns from
     // p.x0, 8–15 the rows from p.y0: one PointWeight), then put on the tile's lanes.
     alignas(64) float sq[16], g[16];
-    AxisWeights(table, p.x0, p.y0, p.cx, p.cy, p.invVariance, sq, g);
+    AxisWeights(p.x0, p.y0, p.cx, p.cy, p.invVariance, sq, g);
     // The columns on the tile's lanes: lanes past the footprint's part hold other columns' values
     // (or zeros), masked off below.
     alignas(64) float dx2s[kStride + 8] = {}, gxs[kStride + 8] = {};
@@ -96,10 +95,9 @@ void DrawPointPairs(D d, const PointRaster& p, const SlabTargets* slabs, const S
     const hn::Half<D> dh;
     const hn::RebindToSigned<D> di;
     constexpr int kHalf = kPairLanes / 2;
-    const PointFilterWeight& table = *p.table;
     const int start = std::min(p.x0 - tileX0, kStride - kHalf);  // the window's first column in the tile
     alignas(64) float sq[kPairLanes], g[kPairLanes];  // lanes 0–7 the window's columns, 8–15 the rows
-    AxisWeights(table, tileX0 + start, p.y0, p.cx, p.cy, p.invVariance, sq, g);
+    AxisWeights(tileX0 + start, p.y0, p.cx, p.cy, p.invVariance, sq, g);
     const V dx2 = hn::Combine(d, hn::Load(dh, sq), hn::Load(dh, sq)), gx = hn::Combine(d, hn::Load(dh, g), hn::Load(dh, g));
     const V eps = hn::Set(d, p.epsilon), rs2 = hn::Set(d, p.radius2), total = hn::Set(d, p.total), norm = hn::Set(d, p.norm);
     const V cr = hn::Set(d, p.color.x), cg = hn::Set(d, p.color.y), cb = hn::Set(d, p.color.z);
@@ -191,15 +189,14 @@ void drawPointVector(const PointRaster& p, const SlabTile& tile) { HWY_DYNAMIC_D
 
 void drawPointSlabsScalar(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0) {
     constexpr int kStride = kTileSize;
-    const PointFilterWeight& table = *p.table;
     for (int y = p.y0; y <= p.y1; ++y) {
         const float dy = PointSetup::offset(y, p.cy), dy2 = dy * dy;
-        const float gy = table.weight(dy2 * p.invVariance);
+        const float gy = pointFilterWeight(dy2 * p.invVariance);
         for (int x = p.x0; x <= p.x1; ++x) {
             const int i = (y - y0) * kStride + (x - x0);
             if (!(T[i] >= p.epsilon)) continue;
             const float dx = PointSetup::offset(x, p.cx), dx2 = dx * dx;
-            const float w = dx2 + dy2 < p.radius2 ? table.weight(dx2 * p.invVariance) * gy : 0.0f;
+            const float w = dx2 + dy2 < p.radius2 ? pointFilterWeight(dx2 * p.invVariance) * gy : 0.0f;
             const float tauAll = p.total * (w * p.norm);
             for (int j = 0; j < slabs.count; ++j) {
                 const float tau = tauAll * slabs.fraction[size_t(j)];

@@ -6,7 +6,7 @@
 //
 // Per pixel (x, y) of the clipped footprint that is still live (T ≥ ε), with
 // dx = (x + ½) − cx, dy = (y + ½) − cy (PointSetup::offset):
-//     w   = dx² + dy² < r_s² ? weight(dx²/V) · weight(dy²/V) : 0     (the table's lookups)
+//     w   = dx² + dy² < r_s² ? weight(dx²/V) · weight(dy²/V) : 0     (pointFilterWeight)
 //     τ   = total · (w · norm)                                      (norm: the sum to 1)
 //     slab τ += τ;  slab emission += τ · colour                      (DESIGN §4: summed per slab)
 // — the float operations of rasterizePoint and of the compositor's per-tile loop before it, in
@@ -40,7 +40,6 @@ struct PointRaster {
     glm::vec3 color{0.f};
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  ///< the footprint's pixels inside the tile (inclusive)
     float epsilon = 0.f;             ///< pixels with T < epsilon are finished
-    const PointFilterWeight* table = nullptr;
 };
 
 /// @brief Adds the point's deposits to the live pixels of @p tile's slab (vector loop).

@@ -22,12 +22,12 @@ double pointDepositTotal(double sigma, double h, double f, const ViewPoint& c) {
     return sigma * M * fz * fz * (glm::length(c) / c.z);
 }
 
-double PointFilterWeight::maxAbsError() const {
+double point_filter_weight::maxAbsError() {
     constexpr int kSamples = 16384;
     double worst = 0.0;
     for (int k = 0; k < kSamples; ++k) {
         const float x = static_cast<float>(kMaxX * k / kSamples);
-        worst = std::max(worst, std::abs(weight(x) - std::exp(-0.5 * x)));
+        worst = std::max(worst, std::abs(pointFilterWeight(x) - std::exp(-0.5 * x)));
     }
     return worst;
 }
@@ -41,7 +41,7 @@ void centresWithin(double x, double rs, int& first, int& count) {
 }
 }  // namespace
 
-PointFootprint rasterizePoint(const PointFilterWeight& table, const PixelCoord& x, double variance) {
+PointFootprint rasterizePoint(const PixelCoord& x, double variance) {
     PointFootprint out;
     if (!std::isfinite(x.x) || !std::isfinite(x.y) || !(variance > 0.0) || x.x < -1e9 || x.x > 1e9 ||
         x.y < -1e9 || x.y > 1e9)
@@ -49,18 +49,18 @@ PointFootprint rasterizePoint(const PointFilterWeight& table, const PixelCoord& 
     const double rs = std::min(kPointSupportSigmas * std::sqrt(variance), kPointMaxRadiusPx);
     centresWithin(x.x, rs, out.x0, out.nx);
     centresWithin(x.y, rs, out.y0, out.ny);
-    // The Gaussian is separable, exp(−(dx² + dy²)/2V) = exp(−dx²/2V)·exp(−dy²/2V): one table
-    // lookup per column and per row (≤ 14, not ≤ 49); the support stays the circle r < r_s.
+    // The Gaussian is separable, exp(−(dx² + dy²)/2V) = exp(−dx²/2V)·exp(−dy²/2V): one weight
+    // per column and per row (≤ 14, not ≤ 49); the support stays the circle r < r_s.
     const float invV = static_cast<float>(1.0 / variance), rs2 = static_cast<float>(rs * rs);
     std::array<float, kPointMaxSide> dxs{}, gx{}, gy{};
     for (int ix = 0; ix < out.nx; ++ix) {
         dxs[ix] = static_cast<float>(out.x0 + ix + 0.5 - x.x);
-        gx[ix] = table.weight(dxs[ix] * dxs[ix] * invV);
+        gx[ix] = pointFilterWeight(dxs[ix] * dxs[ix] * invV);
     }
     std::array<float, kPointSumColumns> columns{};
     for (int iy = 0; iy < out.ny; ++iy) {
         const float dy = static_cast<float>(out.y0 + iy + 0.5 - x.y), dy2 = dy * dy;
-        gy[iy] = table.weight(dy2 * invV);
+        gy[iy] = pointFilterWeight(dy2 * invV);
         for (int ix = 0; ix < out.nx; ++ix) {
             const float w = dxs[ix] * dxs[ix] + dy2 < rs2 ? gx[ix] * gy[iy] : 0.0f;
             out.w[iy * out.nx + ix] = w;
@@ -114,7 +114,7 @@ void finishPointSetup(PointSetup& s, const PixelCoord& x, float sum, float invV,
     }
 }
 
-PointSetup setupPoint(const PointFilterWeight& table, const PixelCoord& x, double variance) {
+PointSetup setupPoint(const PixelCoord& x, double variance) {
     // rasterizePoint's footprint and its sum, in its order (sumColumnsPairwise; a term outside
     // the circle is +0 there and changes no sum), without storing the weights.
     PointSetup s;
@@ -124,12 +124,12 @@ PointSetup setupPoint(const PointFilterWeight& table, const PixelCoord& x, doubl
     for (int ix = 0; ix < s.nx; ++ix) {
         const float dx = static_cast<float>(s.x0 + ix + 0.5 - x.x);
         dx2[size_t(ix)] = dx * dx;
-        gx[size_t(ix)] = table.weight(dx * dx * invV);
+        gx[size_t(ix)] = pointFilterWeight(dx * dx * invV);
     }
     std::array<float, kPointSumColumns> columns{};
     for (int iy = 0; iy < s.ny; ++iy) {
         const float dy = static_cast<float>(s.y0 + iy + 0.5 - x.y), dy2 = dy * dy;
-        const float gy = table.weight(dy2 * invV);
+        const float gy = pointFilterWeight(dy2 * invV);
         for (int ix = 0; ix < s.nx; ++ix) {  // branch-free: which pixels the circle keeps varies point by point
             const float w = gx[size_t(ix)] * gy;
             columns[size_t(ix)] += dx2[size_t(ix)] + dy2 < rs2 ? w : 0.0f;
@@ -137,11 +137,6 @@ PointSetup setupPoint(const PointFilterWeight& table, const PixelCoord& x, doubl
     }
     finishPointSetup(s, x, sumColumnsPairwise(columns.data()), invV, rs2);
     return s;
-}
-
-const PointFilterWeight& standardPointFilter() {
-    static const PointFilterWeight filter;
-    return filter;
 }
 
 }  // namespace vdbsplat

@@ -48,54 +48,55 @@ double pointFilterVariance(double projectedSpacingPx, double prefilterVariance =
 /// @param f focal length (px); @param c view-space voxel centre.
 double pointDepositTotal(double sigma, double h, double f, const ViewPoint& c);
 
-/// @brief The point filter's Gaussian weight exp(−x/2) at x = r²/V ∈ [0, kPointSupportSigmas²).
+/// The constants of pointFilterWeight (below): its support, the polynomial's degree and
+/// coefficients, and the scale from x to the exponent of 2. Shared with the vector weight
+/// (point_weight-inl.h), which must use the same floats.
+namespace point_filter_weight {
+inline constexpr double kMaxX = kPointSupportSigmas * kPointSupportSigmas;
+inline constexpr int kDegree = 6;  ///< 2^f's Taylor polynomial
+/// kMaxX in float: the weight is 0 from it on.
+constexpr float maxX() { return static_cast<float>(kMaxX); }
+/// −log₂e / 2: y = x·kYPerX.
+inline constexpr float kYPerX = static_cast<float>(-0.72134752044448170368);
+/// 2^f = Σ (ln 2)^k/k! f^k: the coefficients, k = 0 … kDegree, rounded to float.
+inline constexpr std::array<float, kDegree + 1> kPow2 = [] {
+    std::array<float, kDegree + 1> c{};
+    double term = 1.0;
+    for (int k = 0; k <= kDegree; ++k) {
+        c[size_t(k)] = static_cast<float>(term);
+        term *= 0.69314718055994530942 / (k + 1);
+    }
+    return c;
+}();
+/// @brief Max |pointFilterWeight − exp(−x/2)| over 16 384 samples of [0, kMaxX).
+double maxAbsError();
+}  // namespace point_filter_weight
+
+/// @brief The point filter's Gaussian weight exp(−x/2) at x = r²/V ∈ [0, kPointSupportSigmas²);
+/// 0 for x ≥ point_filter_weight::kMaxX or NaN. A pure function: nothing to set up or pass.
 /// No table and no gather: exp(−x/2) = 2^y with y = x·(−log₂e/2), split into n = round(y) and
 /// f = y − n ∈ [−½, ½], so 2^y = 2^n·2^f, with 2^f its Taylor polynomial to degree 6 (Horner) and
 /// 2^n an exact power of two. Every step is one float product or sum (no fused multiply-add), so
-/// the scalar weight() and the vector one (point_weight-inl.h) give the same floats on every SIMD
-/// target. Error: the series' remainder (ln 2/2)⁷/7!·2^½ < 1.7e−7 of 2^f, plus a few float
-/// roundings: |weight − exp(−x/2)| < 5e−7 (PointFilter.WeightMatchesTheGaussian; 1.6e−7
+/// the scalar pointFilterWeight() and the vector one (point_weight-inl.h) give the same floats on
+/// every SIMD target. Error: the series' remainder (ln 2/2)⁷/7!·2^½ < 1.7e−7 of 2^f, plus a few
+/// float roundings: |weight − exp(−x/2)| < 5e−7 (PointFilter.WeightMatchesTheGaussian; 1.6e−7
 /// measured). Until session 27 a 1 024-interval table with linear lookups (2.4e−6), whose two
 /// gathers per vector of weights were the far views' point set-up's largest cost. (Files that
 /// evaluate it in vectors are built with -ffp-contract=off, CMakeLists.txt; elsewhere the scalar
 /// form is compiled for the baseline x86-64, which has no fused multiply-add to contract to.)
-class PointFilterWeight {
-public:
-    static constexpr double kMaxX = kPointSupportSigmas * kPointSupportSigmas;
-    static constexpr int kDegree = 6;  ///< 2^f's Taylor polynomial
-
-    /// @brief The unnormalised Gaussian weight at @p x = r²/V; 0 for x ≥ kMaxX or NaN.
-    float weight(float x) const {
-        if (!(x < kMaxXf)) return 0.0f;
-        const float y = (x > 0.0f ? x : 0.0f) * kYPerX;
-        const float n = std::nearbyint(y);  // round half to even, as the vector Round
-        const float f = y - n;
-        float p = kPow2[kDegree];
-        for (int k = kDegree - 1; k >= 0; --k) {
-            const float pf = p * f;
-            p = pf + kPow2[k];
-        }
-        return p * std::bit_cast<float>((static_cast<int>(n) + 127) << 23);
+inline float pointFilterWeight(float x) {
+    namespace pfw = point_filter_weight;
+    if (!(x < pfw::maxX())) return 0.0f;
+    const float y = (x > 0.0f ? x : 0.0f) * pfw::kYPerX;
+    const float n = std::nearbyint(y);  // round half to even, as the vector Round
+    const float f = y - n;
+    float p = pfw::kPow2[pfw::kDegree];
+    for (int k = pfw::kDegree - 1; k >= 0; --k) {
+        const float pf = p * f;
+        p = pf + pfw::kPow2[size_t(k)];
     }
-    /// @brief Max |weight − exp(−x/2)| over 16 384 samples of [0, kMaxX).
-    double maxAbsError() const;
-    static constexpr float maxX() { return kMaxXf; }
-    /// −log₂e / 2: y = x·kYPerX.
-    static constexpr float kYPerX = static_cast<float>(-0.72134752044448170368);
-    /// 2^f = Σ (ln 2)^k/k! f^k: the coefficients, k = 0 … kDegree, rounded to float.
-    static constexpr std::array<float, kDegree + 1> kPow2 = [] {
-        std::array<float, kDegree + 1> c{};
-        double term = 1.0;
-        for (int k = 0; k <= kDegree; ++k) {
-            c[size_t(k)] = static_cast<float>(term);
-            term *= 0.69314718055994530942 / (k + 1);
-        }
-        return c;
-    }();
-
-private:
-    static constexpr float kMaxXf = static_cast<float>(kMaxX);
-};
+    return p * std::bit_cast<float>((static_cast<int>(n) + 127) << 23);
+}
 
 /// @brief The weights of one point: pixel (x0 + ix, y0 + iy) gets w[iy·nx + ix]; they sum
 /// to 1 (up to float rounding). Pixels may lie outside the image: the renderer skips them
@@ -108,9 +109,9 @@ struct PointFootprint {
 
 /// @brief Rasterizes w for a point projected at pixel coordinate @p x with filter variance
 /// @p variance (px², from pointFilterVariance): the pixels whose centres lie strictly
-/// within r_s = min(3√V, 3.5) of @p x, weights exp(−r²/2V) from @p table (PointFilterWeight::weight), renormalised
+/// within r_s = min(3√V, 3.5) of @p x, weights exp(−r²/2V) (pointFilterWeight), renormalised
 /// to sum to 1. A non-finite @p x gives nx = ny = 0. The oracle of PointSetup.
-PointFootprint rasterizePoint(const PointFilterWeight& table, const PixelCoord& x, double variance);
+PointFootprint rasterizePoint(const PixelCoord& x, double variance);
 
 /// @brief A point's filter set up once, at projection, so that each screen tile it touches
 /// evaluates only its own pixels (the compositor; rasterizePoint per tile recomputed the
@@ -134,13 +135,13 @@ struct PointSetup {
 
 /// @brief The PointSetup of a point at @p x (the float centre the compositor uses) with
 /// filter variance @p variance (the float it stores): rasterizePoint's footprint and sum.
-PointSetup setupPoint(const PointFilterWeight& table, const PixelCoord& x, double variance);
+PointSetup setupPoint(const PixelCoord& x, double variance);
 
 /// @brief setupPoint's sum with Google Highway (pointfilter/point_setup.cpp, runtime dispatch):
 /// the weights of both axes in one vector (one PointWeight), the products and the circle row by row
 /// in vectors, each lane a column's sum (sumColumnsPairwise's order). For a float centre (what the renderer stores)
 /// the same PointSetup bit for bit (PointFilter.VectorSetupEqualsTheScalarSetup).
-PointSetup setupPointVector(const PointFilterWeight& table, const PixelCoord& x, double variance);
+PointSetup setupPointVector(const PixelCoord& x, double variance);
 
 /// @brief The footprint's weights summed in the one order every setup uses: each column down
 /// its rows (@p columns[ix] = Σ over iy in order, a weight outside the circle or a column past
@@ -159,14 +160,12 @@ void finishPointSetup(PointSetup& s, const PixelCoord& x, float sum, float invV,
 
 /// @brief One weight of @p s at pixel (@p x, @p y) of its box, for a point centred at
 /// (@p cx, @p cy): the scalar form of what the compositor evaluates per tile.
-inline float pointWeight(const PointFilterWeight& table, const PointSetup& s, float cx, float cy, int x, int y) {
+inline float pointWeight(const PointSetup& s, float cx, float cy, int x, int y) {
     const float dx = PointSetup::offset(x, cx), dy = PointSetup::offset(y, cy);
     const float dy2 = dy * dy;
-    const float w = dx * dx + dy2 < s.radius2 ? table.weight(dx * dx * s.invVariance) * table.weight(dy2 * s.invVariance) : 0.0f;
+    const float w =
+        dx * dx + dy2 < s.radius2 ? pointFilterWeight(dx * dx * s.invVariance) * pointFilterWeight(dy2 * s.invVariance) : 0.0f;
     return w * s.norm;
 }
-
-/// @brief The one point filter every point shares (it holds no state: the weight is a formula).
-const PointFilterWeight& standardPointFilter();
 
 }  // namespace vdbsplat

@@ -17,13 +17,13 @@ namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 
-PointSetup SetupPoint(const PointFilterWeight& table, const PixelCoord& x, double variance) {
+PointSetup SetupPoint(const PixelCoord& x, double variance) {
     PointSetup s;
     float invV = 0.0f, rs2 = 0.0f;
     if (!pointSetupBox(x, variance, s, invV, rs2)) return s;
     // Lanes 0–7: the columns' squared offsets and weights; 8–15: the rows'.
     alignas(64) float sq[16], g[16];
-    AxisWeights(table, s.x0, s.y0, float(x.x), float(x.y), invV, sq, g);
+    AxisWeights(s.x0, s.y0, float(x.x), float(x.y), invV, sq, g);
     // Each column's sum down the rows in a lane (0 outside the circle and past nx; adding +0
     // changes no sum), then the columns pairwise: sumColumnsPairwise's order, as setupPoint's.
     const hn::CappedTag<float, kPointSumColumns> d8;
@@ -54,8 +54,8 @@ namespace vdbsplat {
 
 HWY_EXPORT(SetupPoint);
 
-PointSetup setupPointVector(const PointFilterWeight& table, const PixelCoord& x, double variance) {
-    return HWY_DYNAMIC_DISPATCH(SetupPoint)(table, x, variance);
+PointSetup setupPointVector(const PixelCoord& x, double variance) {
+    return HWY_DYNAMIC_DISPATCH(SetupPoint)(x, variance);
 }
 
 }  // namespace vdbsplat

@@ -1,9 +1,9 @@
-// pointfilter/point_weight-inl.h — PointFilterWeight::weight on every lane of a Highway vector,
-// with weight()'s float operations. Shared by the point setup
+// pointfilter/point_weight-inl.h — pointFilterWeight on every lane of a Highway vector,
+// with its float operations. Shared by the point setup
 // (pointfilter/point_setup.cpp) and the point loop (composite/point_raster.cpp); included once
 // per SIMD target from inside their foreach_target.h passes (Highway's per-target include
 // guard), after <hwy/highway.h>. Compile the including file with -ffp-contract=off: the scalar
-// weight() is the oracle, bit for bit.
+// pointFilterWeight() is the oracle, bit for bit.
 #if defined(VDBSPLAT_POINT_WEIGHT_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef VDBSPLAT_POINT_WEIGHT_INL_H_
 #undef VDBSPLAT_POINT_WEIGHT_INL_H_
@@ -19,19 +19,20 @@ HWY_BEFORE_NAMESPACE();
 namespace vdbsplat {
 namespace HWY_NAMESPACE {
 
-/// PointFilterWeight::weight on every lane: 0 where !(x < maxX) (NaN too); else 2^n·P(f), the
-/// scalar weight()'s products and sums in the same order (no MulAdd: the same floats on every target).
+/// pointFilterWeight on every lane: 0 where !(x < maxX) (NaN too); else 2^n·P(f), the
+/// scalar pointFilterWeight()'s products and sums in the same order (no MulAdd: the same floats on every target).
 template <class D, class V = hwy::HWY_NAMESPACE::Vec<D>>
-HWY_INLINE V PointWeight(D d, const PointFilterWeight&, V x) {
+HWY_INLINE V PointWeight(D d, V x) {
     namespace hn = hwy::HWY_NAMESPACE;
+    namespace pfw = vdbsplat::point_filter_weight;
     const hn::RebindToSigned<D> di;
-    constexpr int kDegree = PointFilterWeight::kDegree;
-    const auto valid = hn::Lt(x, hn::Set(d, PointFilterWeight::maxX()));  // false for NaN
-    const V y = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, PointFilterWeight::kYPerX));
+    constexpr int kDegree = pfw::kDegree;
+    const auto valid = hn::Lt(x, hn::Set(d, pfw::maxX()));  // false for NaN
+    const V y = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, pfw::kYPerX));
     const V n = hn::Round(y);
     const V f = hn::Sub(y, n);
-    V p = hn::Set(d, PointFilterWeight::kPow2[kDegree]);
-    for (int k = kDegree - 1; k >= 0; --k) p = hn::Add(hn::Mul(p, f), hn::Set(d, PointFilterWeight::kPow2[size_t(k)]));
+    V p = hn::Set(d, pfw::kPow2[kDegree]);
+    for (int k = kDegree - 1; k >= 0; --k) p = hn::Add(hn::Mul(p, f), hn::Set(d, pfw::kPow2[size_t(k)]));
     const V scale = hn::BitCast(d, hn::ShiftLeft<23>(hn::Add(hn::ConvertTo(di, n), hn::Set(di, 127))));
     return hn::IfThenElseZero(valid, hn::Mul(p, scale));
 }
@@ -42,7 +43,7 @@ HWY_INLINE V PointWeight(D d, const PointFilterWeight&, V x) {
 /// rounding of the exact difference, as the scalar setup's double difference rounded to float is),
 /// into @p sq, and its weight PointWeight(offset² / V) into @p g. The point setup and the point
 /// loops share it, so their weights are the same floats.
-HWY_INLINE void AxisWeights(const PointFilterWeight& table, int firstX, int firstY, float cx, float cy, float invVariance,
+HWY_INLINE void AxisWeights(int firstX, int firstY, float cx, float cy, float invVariance,
                             float* HWY_RESTRICT sq, float* HWY_RESTRICT g) {
     namespace hn = hwy::HWY_NAMESPACE;
     const hn::CappedTag<float, 16> d;
@@ -56,7 +57,7 @@ HWY_INLINE void AxisWeights(const PointFilterWeight& table, int firstX, int firs
         const auto off = hn::Sub(hn::Add(hn::ConvertTo(d, pixel), hn::Set(d, 0.5f)), centre);
         const auto off2 = hn::Mul(off, off);
         hn::Store(off2, d, sq + k);
-        hn::Store(PointWeight(d, table, hn::Mul(off2, hn::Set(d, invVariance))), d, g + k);
+        hn::Store(PointWeight(d, hn::Mul(off2, hn::Set(d, invVariance))), d, g + k);
     }
 }
 

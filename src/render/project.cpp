@@ -49,8 +49,7 @@ Primitive makePoint(const glm::dvec3& c, float sigma, double spacingPx, double l
 /// each tile it touches, and bins it by its footprint instead of the ±kPointMaxRadiusPx box.
 void setUpPointFilter(Primitive& p, int width, int height, bool vector) {
     const PixelCoord centre(p.centre);
-    const PointSetup s = vector ? setupPointVector(standardPointFilter(), centre, double(p.variance))
-                                : setupPoint(standardPointFilter(), centre, double(p.variance));
+    const PointSetup s = vector ? setupPointVector(centre, double(p.variance)) : setupPoint(centre, double(p.variance));
     p.pointInvVariance = s.invVariance, p.pointRadius2 = s.radius2, p.pointNorm = s.norm;
     if (s.empty()) {
         p.range = {};
@@ -216,7 +215,6 @@ std::optional<PointLaneContext> pointLaneContext(const ProjectionContext& ctx) {
     lanes.lowPass = ctx.lowPass();
     lanes.kernelSigma = ctx.tables.kernel->sigma();
     lanes.width = ctx.camera.width(), lanes.height = ctx.camera.height();
-    lanes.table = &standardPointFilter();
     return lanes;
 }
 

@@ -239,7 +239,7 @@ void PointBoxes(const SplatLanes& L, PointLanes& P, size_t m, const PointLaneCon
 /// kPointMaxSide columns and rows (PointWeight), each column summed down its rows in order (a
 /// pixel outside the circle, a row past ny or a column past nx adding +0), then the columns
 /// pairwise (sumColumnsPairwise). Stores 1/sum as the norm, and the sum.
-void PointSums(PointLanes& P, size_t m, const PointFilterWeight& table, float* sums) {
+void PointSums(PointLanes& P, size_t m, float* sums) {
     const hn::CappedTag<float, 16> d;  // at most 16 lanes: a whole number of them in m
     const hn::RebindToSigned<decltype(d)> di;
     using V = hn::Vec<decltype(d)>;
@@ -259,8 +259,8 @@ void PointSums(PointLanes& P, size_t m, const PointFilterWeight& table, float* s
             const V ox = hn::Sub(hn::Add(hn::ConvertTo(d, hn::Add(x0, hn::Set(di, k))), half), cx);
             const V oy = hn::Sub(hn::Add(hn::ConvertTo(d, hn::Add(y0, hn::Set(di, k))), half), cy);
             dx2[k] = hn::Mul(ox, ox), dy2[k] = hn::Mul(oy, oy);
-            gx[k] = PointWeight(d, table, hn::Mul(dx2[k], invV));
-            gy[k] = PointWeight(d, table, hn::Mul(dy2[k], invV));
+            gx[k] = PointWeight(d, hn::Mul(dx2[k], invV));
+            gy[k] = PointWeight(d, hn::Mul(dy2[k], invV));
             dx2[k] = hn::IfThenElse(hn::RebindMask(d, hn::Lt(hn::Set(di, k), nx)), dx2[k], outside);
             dy2[k] = hn::IfThenElse(hn::RebindMask(d, hn::Lt(hn::Set(di, k), ny)), dy2[k], outside);
         }
@@ -289,7 +289,7 @@ void ProjectPoints(const SplatLanes& L, PointLanes& P, size_t n, const PointLane
     for (size_t k = 0; k < n; ++k) any |= P.status[k] == PointLanes::kPoint;
     if (!any) return;
     alignas(64) float sums[kSplatLanes];
-    PointSums(P, m, *ctx.table, sums);
+    PointSums(P, m, sums);
     // finishPointSetup's one-pixel fallback (an empty sum) stays with the scalar path.
     for (size_t k = 0; k < n; ++k)
         if (P.status[k] == PointLanes::kPoint && !(sums[k] > 0.f)) P.status[k] = PointLanes::kScalar;

@@ -70,8 +70,6 @@ struct SplatLanes {
 /// status and, where the common case holds, the splat (see the file comment).
 void projectSplatsVector(SplatLanes& lanes, size_t n, const SplatLaneContext& ctx);
 
-class PointFilterWeight;
-
 /// What every point lane shares (hybrid or point mode, sphere kernels; from ProjectionContext).
 struct PointLaneContext {
     double focal = 1.0;                  ///< f (pixels)
@@ -82,7 +80,6 @@ struct PointLaneContext {
     PrefilterRamp lowPass;               ///< V folded into each point by its spacing h·f/z (px²)
     double kernelSigma = 1.0;            ///< s_g (voxels)
     int width = 0, height = 0;           ///< image size (pixels)
-    const PointFilterWeight* table = nullptr;  ///< the points' filter (standardPointFilter)
 };
 
 /// The minified voxels of one call (DESIGN §4), structure of arrays: makePoint's point and

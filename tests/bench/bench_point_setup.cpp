@@ -30,12 +30,11 @@ const std::vector<Point>& points() {
     return p;
 }
 
-template <PointSetup (*Setup)(const PointFilterWeight&, const PixelCoord&, double)>
+template <PointSetup (*Setup)(const PixelCoord&, double)>
 void Run(benchmark::State& state) {
-    const PointFilterWeight& table = standardPointFilter();
     for (auto _ : state) {
         float sum = 0.0f;
-        for (const Point& p : points()) sum += Setup(table, p.centre, p.variance).norm;
+        for (const Point& p : points()) sum += Setup(p.centre, p.variance).norm;
         benchmark::DoNotOptimize(sum);
     }
 }

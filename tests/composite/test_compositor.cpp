@@ -200,7 +200,6 @@ Image slowComposite(const std::vector<std::vector<Primitive>>& windows, int w, i
     Image image(w, h);
     std::vector<float> T(size_t(w) * h, 1.f);
     std::vector<glm::vec3> C(size_t(w) * h, glm::vec3(0.f));
-    const PointFilterWeight filter;
     for (const auto& prims : windows) {
         std::vector<size_t> order(prims.size());
         std::iota(order.begin(), order.end(), 0);
@@ -229,7 +228,7 @@ Image slowComposite(const std::vector<std::vector<Primitive>>& windows, int w, i
                     if (p.slab != slabOf || p.kind != PrimitiveKind::Point) flush(), slabOf = p.slab;
                     if (T[pix] < kTransmittanceEpsilon) continue;
                     if (p.kind == PrimitiveKind::Point) {
-                        const PointFootprint fp = rasterizePoint(filter, PixelCoord(p.centre), p.variance);
+                        const PointFootprint fp = rasterizePoint(PixelCoord(p.centre), p.variance);
                         if (x < fp.x0 || x >= fp.x0 + fp.nx || y < fp.y0 || y >= fp.y0 + fp.ny) continue;
                         const float tau = p.total * fp.at(x - fp.x0, y - fp.y0);
                         slabTau += tau, slabEmission += tau * p.color;

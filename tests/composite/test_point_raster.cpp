@@ -19,7 +19,6 @@ struct SlabArrays {
 };
 
 void vectorLoopEqualsTheScalarLoop() {
-    const PointFilterWeight& table = standardPointFilter();
     std::mt19937 rng(13);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     constexpr float kEpsilon = 1e-4f;
@@ -35,7 +34,7 @@ void vectorLoopEqualsTheScalarLoop() {
         // A centre in or near the tile; variances of both low-passes and of --mode none.
         const float cx = float(tx0) - 4.f + float(kTileSize + 8) * u(rng), cy = float(ty0) - 4.f + float(kTileSize + 8) * u(rng);
         const float v = trial % 7 == 0 ? 1.f / 36.f : float(pointFilterVariance(2.5 * u(rng), trial % 2 ? 0.1 : 1.0));
-        const PointSetup s = setupPoint(table, PixelCoord(cx, cy), v);
+        const PointSetup s = setupPoint(PixelCoord(cx, cy), v);
         if (s.empty()) continue;
         PointRaster p;
         p.cx = cx, p.cy = cy, p.invVariance = s.invVariance, p.radius2 = s.radius2, p.norm = s.norm;
@@ -44,7 +43,6 @@ void vectorLoopEqualsTheScalarLoop() {
         p.x0 = std::max(s.x0, tx0), p.x1 = std::min(s.x0 + s.nx - 1, tx0 + kTileSize - 1);
         p.y0 = std::max(s.y0, ty0), p.y1 = std::min(s.y0 + s.ny - 1, ty0 + kTileSize - 1);
         p.epsilon = kEpsilon;
-        p.table = &table;
         const SlabArrays before = a;
         drawPointScalar(p, a.tile(tx0, ty0));
         drawPointVector(p, b.tile(tx0, ty0));
@@ -76,7 +74,7 @@ void vectorLoopEqualsTheScalarLoop() {
                 }
         }
         // The scalar loop deposits total · w with rasterizePoint's w, on live pixels only.
-        const PointFootprint fp = rasterizePoint(table, PixelCoord(cx, cy), v);
+        const PointFootprint fp = rasterizePoint(PixelCoord(cx, cy), v);
         for (int y = ty0; y < ty0 + kTileSize; ++y)
             for (int x = tx0; x < tx0 + kTileSize; ++x) {
                 const size_t i = size_t(y - ty0) * kTileSize + size_t(x - tx0);

@@ -35,19 +35,17 @@ TEST(PointFilter, VarianceIsPrefilterPlusProjectedFootprint) {
 }
 
 TEST(PointFilter, WeightMatchesTheGaussian) {
-    const PointFilterWeight t;
-    EXPECT_LT(t.maxAbsError(), 5e-7);  // the series' remainder, 1.7e−7, and float roundings (1.6e−7 measured)
-    EXPECT_FLOAT_EQ(t.weight(0.0f), 1.0f);
-    EXPECT_EQ(t.weight(9.0f), 0.0f);
-    EXPECT_EQ(t.weight(std::nanf("")), 0.0f);
+    EXPECT_LT(point_filter_weight::maxAbsError(), 5e-7);  // the series' remainder, 1.7e−7, and float roundings (1.6e−7 measured)
+    EXPECT_FLOAT_EQ(pointFilterWeight(0.0f), 1.0f);
+    EXPECT_EQ(pointFilterWeight(9.0f), 0.0f);
+    EXPECT_EQ(pointFilterWeight(std::nanf("")), 0.0f);
 }
 
 TEST(PointFilter, WeightsSumToOneWithinSevenBySeven) {
-    const PointFilterWeight t;
     for (double spacing : {0.0, 0.3, 0.7, 1.0, 1.5, 3.0})
         for (double fx = 0.0; fx < 1.0; fx += 0.125)
             for (double fy = 0.0; fy < 1.0; fy += 0.25) {
-                const PointFootprint fp = rasterizePoint(t, {100.0 + fx, 37.0 + fy}, pointFilterVariance(spacing));
+                const PointFootprint fp = rasterizePoint({100.0 + fx, 37.0 + fy}, pointFilterVariance(spacing));
                 EXPECT_LE(fp.nx, kPointMaxSide);
                 EXPECT_LE(fp.ny, kPointMaxSide);
                 EXPECT_GE(fp.nx, 5);  // V = 1: centres strictly within 3 px
@@ -57,9 +55,8 @@ TEST(PointFilter, WeightsSumToOneWithinSevenBySeven) {
 }
 
 TEST(PointFilter, ShapeIsTheTruncatedGaussianAndSymmetric) {
-    const PointFilterWeight t;
     const double V = pointFilterVariance(1.0);
-    const PointFootprint fp = rasterizePoint(t, {10.5, 20.5}, V);  // at a pixel centre
+    const PointFootprint fp = rasterizePoint({10.5, 20.5}, V);  // at a pixel centre
     ASSERT_EQ(fp.nx, 7);
     ASSERT_EQ(fp.ny, 7);
     EXPECT_EQ(fp.x0, 7);
@@ -95,7 +92,7 @@ struct Energy {
     double splatTable = 0.0, splatExact = 0.0, point = 0.0, maxPixelDiff = 0.0, peak = 0.0;
 };
 
-Energy energyAt(const Tables& tables, const PointFilterWeight& pft, const EnergyCase& ec, double spacingPx) {
+Energy energyAt(const Tables& tables, const EnergyCase& ec, double spacingPx) {
     const double f = 500.0, sigma = 2.0, z = 10.0, h = spacingPx * z / f;
     const PixelCoord pp(200.0 + ec.subX, 200.0 + ec.subY);
     const double t = std::tan(ec.thetaDeg * kDeg);
@@ -107,7 +104,7 @@ Energy energyAt(const Tables& tables, const PointFilterWeight& pft, const Energy
     // Point: projected at the projection of c (what the renderer does), weights × total.
     const PixelCoord proj(pp.x + f * c.x / c.z, pp.y - f * c.y / c.z);
     const double total = pointDepositTotal(sigma, h, f, c);
-    const PointFootprint fp = rasterizePoint(pft, proj, pointFilterVariance(spacingPx));
+    const PointFootprint fp = rasterizePoint(proj, pointFilterVariance(spacingPx));
     for (int k2 = 0; k2 < fp.nx * fp.ny; ++k2) out.point += total * fp.w[k2];
     const PixelRange r = pixelRange(k.bounds);
     for (int y = r.y0; y <= r.y1; ++y)
@@ -127,13 +124,12 @@ Energy energyAt(const Tables& tables, const PointFilterWeight& pft, const Energy
 
 TEST(PointFilterEnergy, SplatEqualsPointAtTheThresholdWithinOnePercent) {
     const Tables tables = buildTables();
-    const PointFilterWeight pft;
     const EnergyCase cases[] = {{0.0, 0.0, 0.0, 0.0},   {0.0, 0.0, 0.37, 0.81}, {0.0, 0.0, 0.5, 0.5},
                                 {10.0, 30.0, 0.2, 0.6}, {20.0, 120.0, 0.9, 0.1}, {35.0, 250.0, 0.45, 0.3}};
     std::printf("energy at the threshold (h f/z = 1 px): splat/point (table, exact), max pixel diff / peak\n");
     double worst = 0.0;
     for (const EnergyCase& ec : cases) {
-        const Energy e = energyAt(tables, pft, ec, 1.0);
+        const Energy e = energyAt(tables, ec, 1.0);
         const double ratio = e.splatTable / e.point, ratioExact = e.splatExact / e.point;
         std::printf("  theta %4.1f° phi %5.1f° sub (%.2f, %.2f): %.5f  %.5f  %.4f\n", ec.thetaDeg, ec.phiDeg, ec.subX,
                     ec.subY, ratio, ratioExact, e.maxPixelDiff / e.peak);
@@ -148,17 +144,15 @@ TEST(PointFilterEnergy, SplatEqualsPointAtTheThresholdWithinOnePercent) {
 TEST(PointFilterEnergy, EnergyMatchesAcrossScales) {
     // Away from the threshold the two paths still carry the same total (zoom does not pop).
     const Tables tables = buildTables();
-    const PointFilterWeight pft;
     for (double spacing : {0.5, 0.8, 1.25, 2.0}) {
-        const Energy e = energyAt(tables, pft, {15.0, 60.0, 0.3, 0.7}, spacing);
+        const Energy e = energyAt(tables, {15.0, 60.0, 0.3, 0.7}, spacing);
         EXPECT_NEAR(e.splatTable / e.point, 1.0, 0.01) << "spacing " << spacing;
     }
 }
 
 TEST(PointFilter, NonFiniteInputGivesNoPixels) {
-    const PointFilterWeight t;
-    EXPECT_EQ(rasterizePoint(t, {std::nan(""), 1.0}, 1.5).nx, 0);
-    EXPECT_EQ(rasterizePoint(t, {1e300, 1.0}, 1.5).nx, 0);
+    EXPECT_EQ(rasterizePoint({std::nan(""), 1.0}, 1.5).nx, 0);
+    EXPECT_EQ(rasterizePoint({1e300, 1.0}, 1.5).nx, 0);
 }
 
 // The filter set up once at projection (PointSetup) gives rasterizePoint's footprint and weights
@@ -166,7 +160,6 @@ TEST(PointFilter, NonFiniteInputGivesNoPixels) {
 // on pixel centres and edges, variances from --mode none's 1/36 to the 3.5 px cap, and ones so
 // small that no pixel centre lies within r_s (rasterizePoint's one-pixel fallback).
 TEST(PointFilter, SetupMatchesTheFootprint) {
-    const PointFilterWeight& t = standardPointFilter();
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     int checked = 0, fallbacks = 0;
@@ -177,8 +170,8 @@ TEST(PointFilter, SetupMatchesTheFootprint) {
         const float v = trial % 5 == 0 ? float(1e-4 + 1e-3 * u(rng))                    // tiny: the fallback
                         : trial % 5 == 1 ? float(kNearestPixelVariance)
                                          : float(pointFilterVariance(3.0 * u(rng), trial % 2 ? 0.1 : 1.0));
-        const PointFootprint fp = rasterizePoint(t, PixelCoord(cx, cy), v);
-        const PointSetup s = setupPoint(t, PixelCoord(cx, cy), v);
+        const PointFootprint fp = rasterizePoint(PixelCoord(cx, cy), v);
+        const PointSetup s = setupPoint(PixelCoord(cx, cy), v);
         ASSERT_EQ(s.x0, fp.x0);
         ASSERT_EQ(s.y0, fp.y0);
         ASSERT_EQ(s.nx, fp.nx);
@@ -186,21 +179,20 @@ TEST(PointFilter, SetupMatchesTheFootprint) {
         fallbacks += s.norm == 1.0f && s.invVariance == 0.0f;
         for (int iy = 0; iy < fp.ny; ++iy)
             for (int ix = 0; ix < fp.nx; ++ix, ++checked)
-                ASSERT_EQ(pointWeight(t, s, cx, cy, fp.x0 + ix, fp.y0 + iy), fp.at(ix, iy))
+                ASSERT_EQ(pointWeight(s, cx, cy, fp.x0 + ix, fp.y0 + iy), fp.at(ix, iy))
                     << "centre " << cx << ", " << cy << " V " << v << " pixel " << ix << ", " << iy;
     }
     EXPECT_GT(checked, 100000);
     EXPECT_GT(fallbacks, 100);
-    EXPECT_TRUE(setupPoint(t, {std::nan(""), 1.0}, 1.5).empty());
-    EXPECT_TRUE(setupPoint(t, {1e300, 1.0}, 1.5).empty());
-    EXPECT_TRUE(setupPoint(t, {1.0, 1.0}, 0.0).empty());
+    EXPECT_TRUE(setupPoint({std::nan(""), 1.0}, 1.5).empty());
+    EXPECT_TRUE(setupPoint({1e300, 1.0}, 1.5).empty());
+    EXPECT_TRUE(setupPoint({1.0, 1.0}, 0.0).empty());
 }
 
 // The vector setup (setupPointVector: both axes' weights in one vector, the terms row by row in
 // vectors, the sum in the scalar order) is the scalar setup bit for bit, for float centres (what
 // the renderer stores), including centres at and near 0, past the image's edges, and the fallback.
 void vectorSetupEqualsTheScalarSetup() {
-    const PointFilterWeight& t = standardPointFilter();
     std::mt19937 rng(9);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     int fallbacks = 0;
@@ -212,7 +204,7 @@ void vectorSetupEqualsTheScalarSetup() {
         const float v = kind == 2 ? float(1e-4 + 1e-3 * u(rng))
                         : kind == 3 ? float(kNearestPixelVariance)
                                     : float(pointFilterVariance(4.0 * u(rng), trial % 2 ? 0.1 : 1.0));
-        const PointSetup a = setupPoint(t, PixelCoord(cx, cy), v), b = setupPointVector(t, PixelCoord(cx, cy), v);
+        const PointSetup a = setupPoint(PixelCoord(cx, cy), v), b = setupPointVector(PixelCoord(cx, cy), v);
         ASSERT_EQ(a.x0, b.x0) << trial;
         ASSERT_EQ(a.y0, b.y0) << trial;
         ASSERT_EQ(a.nx, b.nx) << trial;
@@ -223,7 +215,7 @@ void vectorSetupEqualsTheScalarSetup() {
         fallbacks += a.invVariance == 0.0f && !a.empty();
     }
     EXPECT_GT(fallbacks, 100);
-    EXPECT_TRUE(setupPointVector(t, {std::nan(""), 1.0}, 1.5).empty());
+    EXPECT_TRUE(setupPointVector({std::nan(""), 1.0}, 1.5).empty());
 }
 
 // On every SIMD target the binary holds (the weight's float steps must agree on each).

@@ -48,8 +48,7 @@ ProjectionContext contextFor(const Camera& cam, RenderMode mode, double h, Footp
 /// τ of a Point or (table-path) Splat primitive at pixel (x, y): the compositor's maths, slowly.
 double depositAt(const Primitive& p, int x, int y) {
     if (p.kind == PrimitiveKind::Point) {
-        static const PointFilterWeight table;
-        const PointFootprint fp = rasterizePoint(table, PixelCoord(p.centre), p.variance);
+        const PointFootprint fp = rasterizePoint(PixelCoord(p.centre), p.variance);
         const int ix = x - fp.x0, iy = y - fp.y0;
         return ix >= 0 && iy >= 0 && ix < fp.nx && iy < fp.ny ? p.total * fp.at(ix, iy) : 0.0;
     }
