@@ -30,7 +30,8 @@ struct ZeroedAllocator {
     ZeroedAllocator(const ZeroedAllocator<U>&) noexcept {}
     /// Blocks of kMapBytes and more are mapped, not calloc'ed: after glibc has freed one such
     /// block its dynamic mmap threshold rises past it, so the next frame's calloc came from the
-    /// heap and cleared all 16 MB of a 1024² image (~6 % of a warm far render: bench, animate).
+    /// heap and cleared all 16 MB of a 1024² image (a few per cent of a warm far render: bench,
+    /// animate, render --warmup; docs/performance.md, session 28).
     static constexpr size_t kMapBytes = size_t(1) << 20;
     T* allocate(size_t n) {
         if (n > size_t(-1) / sizeof(T)) throw std::bad_alloc();
