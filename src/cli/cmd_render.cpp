@@ -116,10 +116,10 @@ int runRender(const Args& args) {
     ForwardBuffers buffers;  // kept between the warm-up renders and the timed one
     if (warmup > 0) control.buffers = &buffers;
     try {
+        RenderControl quiet = control;  // no progress for the untimed renders
+        quiet.progress = nullptr;
         for (int i = 0; i < warmup; ++i) {
             RenderStats untimed;
-            RenderControl quiet = control;
-            quiet.progress = nullptr;
             (void)render(volume, tf, settings, untimed, quiet);
         }
         image = render(volume, tf, settings, stats, control);

@@ -4,8 +4,6 @@
 // metadata; OpenEXR), atomically: a temporary file in the same folder, renamed into
 // place, so a failure never leaves a partial image; reading PNG or EXR back (`compare`).
 #pragma once
-#include <sys/mman.h>
-
 #include <glm/glm.hpp>
 #include <cstdint>
 #include <cstdlib>
@@ -14,6 +12,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "util/huge_pages.h"
 
 namespace vdbsplat {
 
@@ -28,23 +28,20 @@ struct ZeroedAllocator {
     ZeroedAllocator() = default;
     template <class U>
     ZeroedAllocator(const ZeroedAllocator<U>&) noexcept {}
-    /// Blocks of kMapBytes and more are mapped, not calloc'ed: after glibc has freed one such
-    /// block its dynamic mmap threshold rises past it, so the next frame's calloc came from the
-    /// heap and cleared all 16 MB of a 1024² image (a few per cent of a warm far render: bench,
-    /// animate, render --warmup; docs/performance.md, session 28).
+    /// Blocks of kMapBytes and more are fresh anonymous pages (huge_pages::map, as the renderer's
+    /// window buffers), not calloc'ed: after glibc has freed one such block its dynamic mmap
+    /// threshold rises past it, so the next frame's calloc came from the heap and cleared all
+    /// 16 MB of a 1024² image (a few per cent of a warm far render: bench, animate, render
+    /// --warmup; docs/performance.md, session 28).
     static constexpr size_t kMapBytes = size_t(1) << 20;
     T* allocate(size_t n) {
         if (n > size_t(-1) / sizeof(T)) throw std::bad_alloc();
-        if (n * sizeof(T) >= kMapBytes) {
-            void* p = mmap(nullptr, n * sizeof(T), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-            if (p == MAP_FAILED) throw std::bad_alloc();
-            return static_cast<T*>(p);
-        }
+        if (n * sizeof(T) >= kMapBytes) return static_cast<T*>(huge_pages::map(huge_pages::roundUp(n * sizeof(T))));
         if (void* p = std::calloc(n, sizeof(T))) return static_cast<T*>(p);
         throw std::bad_alloc();
     }
     void deallocate(T* p, size_t n) noexcept {
-        if (n * sizeof(T) >= kMapBytes) munmap(p, n * sizeof(T));
+        if (n * sizeof(T) >= kMapBytes) munmap(p, huge_pages::roundUp(n * sizeof(T)));
         else std::free(p);
     }
     template <class U>

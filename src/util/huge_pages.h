@@ -1,7 +1,8 @@
 // util/huge_pages.h — an allocator for the renderer's large per-window buffers.
 // Owns: HugePageAllocator, a standard allocator that maps blocks of 2 MiB and more as
 // anonymous memory advised for transparent huge pages (madvise MADV_HUGEPAGE), and smaller
-// blocks through operator new.
+// blocks through operator new; huge_pages::map, which the output image's large blocks use too
+// (image/image.h: fresh zero pages for every frame).
 //
 // Why: the first touch of a fresh 4 KiB page costs a fault, and on the virtual machines this
 // project is measured on a fault costs 20–30 µs (docs/performance.md, "Loading"): touching 64 MiB
