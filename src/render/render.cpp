@@ -1,6 +1,8 @@
 // render/render.cpp — mode dispatch (see render.h).
 #include "render/render.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -89,9 +91,18 @@ RenderSettings resolvedFor(const Volume& volume, const Camera& camera, RenderSet
     return settings;
 }
 
+namespace {
+/// Minor page faults of the process so far (0 where getrusage fails).
+uint64_t minorPageFaults() {
+    rusage usage{};
+    return getrusage(RUSAGE_SELF, &usage) == 0 ? uint64_t(usage.ru_minflt) : 0;
+}
+}  // namespace
+
 Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& requested, RenderStats& stats,
              const RenderControl& control) {
     const auto start = std::chrono::steady_clock::now();
+    const uint64_t faultsBefore = minorPageFaults();
     if (control.stop && control.stop()) throw RenderStopped("render stopped before it began");
     checkVoxelBudget(volume, requested);
     checkKernelShape(volume, requested);
@@ -139,6 +150,8 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
         }
     }
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const uint64_t faultsAfter = minorPageFaults();
+    stats.pageFaults = faultsAfter > faultsBefore ? faultsAfter - faultsBefore : 0;
     if (control.progress) control.progress(1.0);
     return image;
 }

@@ -173,6 +173,7 @@ nlohmann::json RenderStats::toJson() const {
     j["windows"] = windows;
     j["largest_window_voxels"] = largestWindow;
     if (compositedPixels) j["composited_pixels"] = compositedPixels;
+    j["page_faults"] = pageFaults;
     const uint64_t drawn = points + splats;
     j["splat_fraction"] = drawn ? double(splats) / double(drawn) : 0.0;
     if (rays) j["rays"] = rays;

@@ -203,6 +203,10 @@ struct RenderStats {
     uint64_t windows = 0;             ///< forward modes: depth windows streamed
     uint64_t largestWindow = 0;       ///< forward modes: most voxels in one window
     uint64_t compositedPixels = 0;    ///< forward modes: pixels (sub-pixels) the compositor held (the crop)
+    /// Minor page faults of the process during the render: the fresh memory it touched, a page (or
+    /// a huge page) each. On virtual machines a fault costs microseconds (docs/performance.md,
+    /// session 29); a render through kept buffers (RenderControl::buffers) takes few.
+    uint64_t pageFaults = 0;
     uint64_t rays = 0;  ///< reference: rays traced
     int raysPerPixel = 0;  ///< reference: the --spp actually used (rounded up to a square)
     double shadingSeconds = 0.0;  ///< the shading pass (0 when shading is off)

@@ -875,6 +875,11 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                 VoxelBatch& e = extracted_[c];
                 e.clear();
                 const size_t chunkEnd = std::min(count, (c + 1) * kExtractChunk);
+                // Room for the chunk's records at once: grown block by block, the arrays were
+                // reallocated and copied up to five times per chunk, each time into fresh pages.
+                size_t expected = 0;
+                for (size_t j = c * kExtractChunk; j < chunkEnd; ++j) expected += recordsOf(block(first + j));
+                if (e.viewPos.capacity() < expected) e.reserve(expected, options_.depthSpread);
                 for (size_t j = c * kExtractChunk; j < chunkEnd; ++j) {
                     const size_t i = first + j;
                     const Block& b = block(i);

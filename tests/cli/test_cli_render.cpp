@@ -530,7 +530,7 @@ TEST_F(CliRender, StatsJsonHasCountsTimingsAndSettings) {
     EXPECT_NE(r.out.find("hybrid 32x32"), std::string::npos) << r.out;
     const nlohmann::json j = nlohmann::json::parse(slurp(stats));
     for (const char* key : {"seconds", "width", "height", "active_voxels", "mode", "points", "splats", "culled",
-                            "splat_fraction", "stage_seconds", "tables", "camera", "input", "grid"})
+                            "splat_fraction", "stage_seconds", "tables", "camera", "input", "grid", "page_faults"})
         EXPECT_TRUE(j.contains(key)) << key << " in " << j.dump();
     EXPECT_EQ(j["mode"], "hybrid");
     EXPECT_EQ(j["width"], 32);

@@ -609,6 +609,23 @@ TEST(Forward, KeptBuffersDoNotChangeTheImage) {
     EXPECT_GT(buffers.window.size, 0u);  // the renders went through the kept buffers
 }
 
+// A render's page_faults count the fresh memory it touched: a render through kept buffers touches
+// only the new output image's pages, a render with buffers of its own every buffer's as well.
+TEST(Forward, KeptBuffersTakeFewerPageFaults) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    const RenderSettings s = settingsFor(RenderMode::Hybrid, 1.0, 256);
+    ForwardBuffers buffers;
+    RenderControl control;
+    control.buffers = &buffers;
+    RenderStats first, kept, own;
+    render(marschnerLobb(), tf, s, first, control);  // fills the kept buffers
+    render(marschnerLobb(), tf, s, kept, control);
+    render(marschnerLobb(), tf, s, own, RenderControl{});
+    EXPECT_GT(own.pageFaults, 0u);  // fresh window buffers are always new mappings or new heap
+    EXPECT_LT(kept.pageFaults, own.pageFaults);
+    EXPECT_EQ(kept.toJson()["page_faults"], kept.pageFaults);
+}
+
 // The same with the level of detail in its passages (voxels → 2³ at distance 2, aggregate levels
 // further out): blended blocks, hashed cell ramps and split weights are per block, so the image is
 // bit-identical for 1 and 2 threads.
