@@ -18,6 +18,12 @@
 namespace vdbsplat {
 
 struct ForwardBuffers {
+    /// Keep the level-of-detail moments for the next render of the same grid and table
+    /// (StreamOptions::keepMoments). False for a caller that renders once and passes buffers only
+    /// so that the render does not free them (`render`: they are freed after the image is
+    /// written; freeing them inside the render took 2–6 ms of a one-shot render on this project's
+    /// virtual machines, docs/performance.md, session 29).
+    bool keepMoments = true;
     VoxelBatch batch;               ///< one window's voxels
     ProjectedWindow window;         ///< one window's primitives
     StreamBuffers stream;           ///< VoxelStream's pending and extracted voxels

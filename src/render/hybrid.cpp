@@ -70,7 +70,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     // bounds still narrow it; windows split only at slab boundaries, so the image is the same).
     streamOptions.slabsPerWindow = int(std::lround(streamOptions.slabsPerWindow / streamOptions.slabThickness));
     streamOptions.lodCellPx = pass.lodPx;
-    streamOptions.keepMoments = control.buffers != nullptr;  // renders that keep buffers keep the moments too
+    streamOptions.keepMoments = control.buffers && control.buffers->keepMoments;  // bench, animate, study, --warmup
     streamOptions.lodBlend = settings.effectiveLodBlend();
     streamOptions.pointPrefilterVariance = pass.lodPrefilterVariance;
     streamOptions.pointBelowPx = settings.mode == RenderMode::Point ? INFINITY

@@ -626,6 +626,28 @@ TEST(Forward, KeptBuffersTakeFewerPageFaults) {
     EXPECT_EQ(kept.toJson()["page_faults"], kept.pageFaults);
 }
 
+// `render` passes buffers to a single render only so that the render does not free them inside its
+// time (ForwardBuffers::keepMoments false): the level-of-detail moments are then not kept, as for
+// a render with buffers of its own, and the image is the same.
+TEST(Forward, BuffersThatKeepNoMomentsKeepNone) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    const RenderSettings s = settingsFor(RenderMode::Hybrid, 8.0, 72);  // level of detail: moments to keep
+    const Image fresh = renderWith(marschnerLobb(), tf, s);
+    for (const bool keep : {false, true}) {
+        ForwardBuffers buffers;
+        buffers.keepMoments = keep;
+        RenderControl control;
+        control.buffers = &buffers;
+        RenderStats stats;
+        const Image image = render(marschnerLobb(), tf, s, stats, control);
+        EXPECT_GT(stats.lodAggregates, 0u);
+        EXPECT_EQ(buffers.stream.moments.key != 0, keep) << keep;
+        EXPECT_GT(buffers.window.size, 0u) << keep;  // the render went through the buffers
+        ASSERT_EQ(image.pixels.size(), fresh.pixels.size());
+        for (size_t i = 0; i < image.pixels.size(); ++i) ASSERT_EQ(image.pixels[i], fresh.pixels[i]) << keep << " pixel " << i;
+    }
+}
+
 // The same with the level of detail in its passages (voxels → 2³ at distance 2, aggregate levels
 // further out): blended blocks, hashed cell ramps and split weights are per block, so the image is
 // bit-identical for 1 and 2 threads.
