@@ -115,7 +115,7 @@ int runRender(const Args& args) {
     Image image;
     // Kept between the warm-up renders and the timed one, and in every case freed only after the
     // image is written: a render that frees its own buffers pays for the unmapping inside its
-    // time (2–6 ms of a one-shot render here; docs/performance.md, session 29). A single render
+    // time (2–10 ms of a one-shot render here; docs/performance.md, session 29). A single render
     // keeps no level-of-detail moments (it would only fill them).
     ForwardBuffers buffers;
     buffers.keepMoments = warmup > 0;

@@ -21,7 +21,7 @@ struct ForwardBuffers {
     /// Keep the level-of-detail moments for the next render of the same grid and table
     /// (StreamOptions::keepMoments). False for a caller that renders once and passes buffers only
     /// so that the render does not free them (`render`: they are freed after the image is
-    /// written; freeing them inside the render took 2–6 ms of a one-shot render on this project's
+    /// written; freeing them inside the render took 2–10 ms of a one-shot render on this project's
     /// virtual machines, docs/performance.md, session 29).
     bool keepMoments = true;
     VoxelBatch batch;               ///< one window's voxels
