@@ -2,12 +2,15 @@
 // thread, then two), of transparent huge pages (madvise MADV_HUGEPAGE), and the same 4 KiB pages
 // faulted in by one madvise(MADV_POPULATE_WRITE) call. Run it twice a few seconds apart: huge pages
 // the previous process freed a moment ago are cheap, ones the guest handed back to the host are not
-// ("warm" and "cold" in docs/performance.md, session 29). Not part of the build:
-//   g++ -O2 -pthread -o /tmp/fault-cost scripts/fault-cost.cpp && /tmp/fault-cost; sleep 5; /tmp/fault-cost
+// ("warm" and "cold" in docs/performance.md, session 29); the optional argument is the block's
+// size in MiB (default 8; 40 asks for 20 huge pages, more than a previous run freed). Not part
+// of the build:
+//   g++ -O2 -pthread -o /tmp/fault-cost scripts/fault-cost.cpp && /tmp/fault-cost; sleep 5; /tmp/fault-cost 40
 #include <sys/mman.h>
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <thread>
 
 #ifndef MADV_POPULATE_WRITE
@@ -34,8 +37,10 @@ void touch(char* p, size_t bytes) {
 }
 }  // namespace
 
-int main() {
-    const size_t bytes = size_t(8) << 20;
+int main(int argc, char** argv) {
+    const long mib = argc > 1 ? std::atol(argv[1]) : 8;
+    if (mib < 2 || mib % 2 != 0) return std::fprintf(stderr, "usage: fault-cost [MiB, even, at least 2]\n"), 2;
+    const size_t bytes = size_t(mib) << 20;
     char* raw = nullptr;
     char* p = freshBlock(bytes, MADV_NOHUGEPAGE, raw);
     if (!p) return 1;
@@ -64,7 +69,7 @@ int main() {
     munmap(raw, bytes + kHuge);
 
     const double pages = double(bytes) / 4096.0, hugePages = double(bytes) / double(kHuge);
-    std::printf("8 MiB of fresh memory:\n");
+    std::printf("%ld MiB of fresh memory:\n", mib);
     std::printf("  4 KiB pages touched, one thread   %7.2f ms  (%5.1f us a page)\n", small1, small1 * 1e3 / pages);
     std::printf("  4 KiB pages touched, two threads  %7.2f ms  (%5.1f us a page)\n", small2, small2 * 1e3 / pages);
     std::printf("  4 KiB pages, MADV_POPULATE_WRITE  %7.2f ms  (%5.2f us a page)%s\n", populate, populate * 1e3 / pages,
