@@ -36,7 +36,11 @@ struct ZeroedAllocator {
     static constexpr size_t kMapBytes = size_t(1) << 20;
     T* allocate(size_t n) {
         if (n > size_t(-1) / sizeof(T)) throw std::bad_alloc();
-        if (n * sizeof(T) >= kMapBytes) return static_cast<T*>(huge_pages::map(huge_pages::roundUp(n * sizeof(T))));
+        if (n * sizeof(T) >= kMapBytes) {
+            void* p = huge_pages::map(huge_pages::roundUp(n * sizeof(T)));
+            huge_pages::adviseWritten(p, n * sizeof(T));
+            return static_cast<T*>(p);
+        }
         if (void* p = std::calloc(n, sizeof(T))) return static_cast<T*>(p);
         throw std::bad_alloc();
     }

@@ -1,17 +1,22 @@
 // util/huge_pages.h — an allocator for the renderer's large per-window buffers.
 // Owns: HugePageAllocator, a standard allocator that maps blocks of 2 MiB and more as
-// anonymous memory advised for transparent huge pages (madvise MADV_HUGEPAGE), and smaller
-// blocks through operator new; huge_pages::map, which the output image's large blocks use too
-// (image/image.h: fresh zero pages for every frame).
+// anonymous memory aligned for transparent huge pages, and smaller blocks through operator new;
+// huge_pages::map, which the output image's large blocks use too (image/image.h: fresh zero
+// pages for every frame); adviseWritten, which asks for huge pages (madvise MADV_HUGEPAGE) only
+// over the part of a block a caller is about to write, and growDiscarding, which does so.
 //
 // Why: the first touch of a fresh 4 KiB page costs a fault, and on the virtual machines this
 // project is measured on a fault costs 20–30 µs (docs/performance.md, "Loading"): touching 64 MiB
 // of fresh malloc memory took 0.35–0.44 s there, the same memory in huge pages 0.006–0.2 s. The
 // projected window, its sort order, the gathered tile records and the frame are tens of MiB, grown
-// window after window; in 2 MiB pages they fault 512× less often. Where the kernel gives no huge
-// pages (THP off, or none free), the memory is ordinary pages: correct, only not faster.
+// window after window; in 2 MiB pages they fault 512× less often. But a huge page is cleared (and
+// backed) whole at its first touch, so only the huge pages a caller fills at least half of are
+// advised (session 30). Where the kernel gives no huge pages (THP off, or none free), the memory
+// is ordinary pages: correct, only not faster.
 #pragma once
 #include <sys/mman.h>
+
+#include <algorithm>
 
 #include <cstddef>
 #include <new>
@@ -36,9 +41,17 @@ inline void* map(std::size_t bytes) {
     if (aligned > start) munmap(raw, aligned - start);
     if (const std::size_t tail = start + bytes + kHugePage - (aligned + bytes); tail > 0)
         munmap(reinterpret_cast<void*>(aligned + bytes), tail);
-    void* p = reinterpret_cast<void*>(aligned);
-    madvise(p, bytes, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
-    return p;
+    return reinterpret_cast<void*>(aligned);
+}
+/// @brief Advises huge pages for the huge pages of a block from map() (which starts on a
+/// huge-page boundary) that its first @p bytes, the part a caller is about to write, fill at least
+/// half of. Memory is mapped unadvised: a huge page costs its whole 2 MiB at the first touch (cleared
+/// by the kernel, and on a paravirtualised host backed by the host too: 1.3–3.3 ms cold here), and a
+/// window that writes 100 KiB of a buffer reserved for 2^18 records paid that for each of its
+/// arrays; a 4 KiB page costs ~11 µs (docs/performance.md, session 30).
+inline void adviseWritten(void* p, std::size_t bytes) {
+    const std::size_t pages = (bytes + kHugePage / 2) / kHugePage;
+    if (pages > 0) madvise(p, pages * kHugePage, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
 }
 }  // namespace huge_pages
 
@@ -81,8 +94,17 @@ struct HugePageAllocator {
     bool operator==(const HugePageAllocator<U>&) const noexcept { return true; }
 };
 
+/// @brief huge_pages::adviseWritten for the first @p n elements of @p buffer, if its block came
+/// from huge_pages::map (2 MiB and more).
+template <class Buffer>
+void adviseWritten(Buffer& buffer, std::size_t n) {
+    constexpr std::size_t kSize = sizeof(typename Buffer::value_type);
+    if (buffer.capacity() * kSize >= huge_pages::kHugePage) huge_pages::adviseWritten(buffer.data(), std::min(n, buffer.capacity()) * kSize);
+}
+
 /// @brief Grows @p buffer to at least @p n elements without keeping its contents (a window's
-/// buffers are rewritten whole): no copy on growth. Never shrinks.
+/// buffers are rewritten whole): no copy on growth. Never shrinks. The first n are advised for
+/// huge pages (adviseWritten): the caller writes them.
 ///
 /// It grows to 4n: address space, not memory. The allocator constructs nothing (construct()
 /// above), so only the pages a window writes are faulted in, and a later window up to 4n reuses
@@ -93,9 +115,10 @@ struct HugePageAllocator {
 /// largest window (DESIGN §5).
 template <class Buffer>
 void growDiscarding(Buffer& buffer, std::size_t n) {
-    if (buffer.size() >= n) return;
-    Buffer().swap(buffer);
-    buffer.resize(n > buffer.max_size() / 4 ? n : 4 * n);
+    if (buffer.size() < n) {
+        Buffer().swap(buffer);
+        buffer.resize(n > buffer.max_size() / 4 ? n : 4 * n);
+    }
+    adviseWritten(buffer, n);
 }
-
 }  // namespace vdbsplat

@@ -41,6 +41,13 @@ void VoxelBatch::resize(size_t n) {
     spread.resize(n);
     depthSpread.resize(withDepthSpread ? n : 0);
     members.resize(n);
+    adviseWritten(n);
+}
+
+void VoxelBatch::adviseWritten(size_t n) {
+    vdbsplat::adviseWritten(viewPos, n), vdbsplat::adviseWritten(distance, n), vdbsplat::adviseWritten(sigma, n);
+    vdbsplat::adviseWritten(color, n), vdbsplat::adviseWritten(spread, n), vdbsplat::adviseWritten(members, n);
+    if (withDepthSpread) vdbsplat::adviseWritten(depthSpread, n);
 }
 
 void VoxelBatch::reserve(size_t n, bool depthSpreads) {

@@ -63,6 +63,7 @@ struct VoxelBatch {
     void clear();           ///< empties every array, keeping their capacity
     void resize(size_t n);  ///< every array to @p n records
     void reserve(size_t n, bool depthSpreads);  ///< room for @p n records in every array (no pages touched)
+    void adviseWritten(size_t n);  ///< the first @p n records of every array are about to be written (util/huge_pages.h)
 };
 
 /// Level of detail: the largest spread a uniform cell would add, s²(n² − 1)/12, as a fraction of

@@ -1,13 +1,18 @@
 // tests/util/test_huge_pages.cpp — the large-buffer allocator (util/huge_pages.h): blocks of
 // 2 MiB and more are huge-page aligned and usable to their last byte, small ones come from
 // operator new; elements are default-initialised; growDiscarding grows to 4n of address space
-// (not resident until written), never shrinks, and does not copy.
+// (not resident until written), never shrinks, and does not copy; only the huge pages a caller
+// fills at least half of are advised for huge pages (adviseWritten).
 #include <gtest/gtest.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
 #include <cstdint>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <numeric>
+#include <optional>
 #include <vector>
 
 #include "util/huge_pages.h"
@@ -68,6 +73,45 @@ TEST(HugePages, GrowDiscardingHeadroomIsNotResident) {
     EXPECT_TRUE(resident((4u << 20) - 1));
     EXPECT_FALSE(resident(v.size() - 1));       // 48 MB past what was written
     EXPECT_FALSE(resident(v.size() / 2 + 17));  // 16 MB past it
+}
+
+/// Whether the mapping holding @p address is advised for huge pages ("hg" in its VmFlags in
+/// /proc/self/smaps); nullopt where smaps cannot be read.
+std::optional<bool> advisedHuge(const void* address) {
+    std::ifstream smaps("/proc/self/smaps");
+    if (!smaps) return std::nullopt;
+    const auto at = reinterpret_cast<uintptr_t>(address);
+    bool inside = false;
+    for (std::string line; std::getline(smaps, line);) {
+        uintptr_t lo = 0, hi = 0;
+        char dash = 0;
+        std::istringstream range(line);
+        if (range >> std::hex >> lo >> dash >> hi && dash == '-' && line.find(' ') != std::string::npos &&
+            line.find(':') > line.find(' ')) {
+            inside = lo <= at && at < hi;
+            continue;
+        }
+        if (inside && line.rfind("VmFlags:", 0) == 0) return line.find(" hg") != std::string::npos;
+    }
+    return std::nullopt;
+}
+
+// A window that writes a little of a large block takes ordinary pages: a huge page is cleared whole
+// at its first touch. The huge pages the written part fills at least half of are advised.
+TEST(HugePages, OnlyTheWrittenHugePagesAreAdvised) {
+    void* probe = huge_pages::map(huge_pages::kHugePage);
+    const bool supported = madvise(probe, huge_pages::kHugePage, MADV_HUGEPAGE) == 0;
+    munmap(probe, huge_pages::kHugePage);
+    if (!supported) GTEST_SKIP() << "madvise(MADV_HUGEPAGE) is not supported here";
+    std::vector<uint32_t, HugePageAllocator<uint32_t>> v;
+    growDiscarding(v, 200'000);  // 800 kB to write, 3.2 MB mapped: less than half a huge page
+    ASSERT_EQ(reinterpret_cast<uintptr_t>(v.data()) % huge_pages::kHugePage, 0u);
+    const std::optional<bool> before = advisedHuge(v.data());
+    if (!before) GTEST_SKIP() << "/proc/self/smaps cannot be read";
+    EXPECT_FALSE(*before);
+    growDiscarding(v, 300'000);  // 1.2 MB: more than half of the first huge page, none of the second
+    EXPECT_EQ(advisedHuge(v.data()), std::optional<bool>(true));
+    EXPECT_EQ(advisedHuge(v.data() + huge_pages::kHugePage / sizeof(uint32_t)), std::optional<bool>(false));
 }
 
 }  // namespace
