@@ -102,6 +102,23 @@ void adviseWritten(Buffer& buffer, std::size_t n) {
     if (buffer.capacity() * kSize >= huge_pages::kHugePage) huge_pages::adviseWritten(buffer.data(), std::min(n, buffer.capacity()) * kSize);
 }
 
+/// @brief Resizes @p buffer to @p n elements, keeping its contents, with its first n advised
+/// (adviseWritten: the caller writes what is new). Growth past the capacity takes a block of at
+/// least twice it, advised before the old elements are copied in: std::vector's own growth would
+/// copy them into unadvised pages first.
+template <class Buffer>
+void resizeWritten(Buffer& buffer, std::size_t n) {
+    if (n > buffer.capacity()) {
+        Buffer bigger;
+        bigger.reserve(std::max(n, 2 * buffer.capacity()));
+        adviseWritten(bigger, n);
+        bigger.assign(buffer.begin(), buffer.end());
+        buffer.swap(bigger);
+    }
+    buffer.resize(n);
+    adviseWritten(buffer, n);
+}
+
 /// @brief Grows @p buffer to at least @p n elements without keeping its contents (a window's
 /// buffers are rewritten whole): no copy on growth. Never shrinks. The first n are advised for
 /// huge pages (adviseWritten): the caller writes them.

@@ -34,20 +34,8 @@ constexpr uint64_t kMaxActiveVoxels = uint64_t(1) << 32;
 }  // namespace
 
 void VoxelBatch::resize(size_t n) {
-    viewPos.resize(n);
-    distance.resize(n);
-    sigma.resize(n);
-    color.resize(n);
-    spread.resize(n);
-    depthSpread.resize(withDepthSpread ? n : 0);
-    members.resize(n);
-    adviseWritten(n);
-}
-
-void VoxelBatch::adviseWritten(size_t n) {
-    vdbsplat::adviseWritten(viewPos, n), vdbsplat::adviseWritten(distance, n), vdbsplat::adviseWritten(sigma, n);
-    vdbsplat::adviseWritten(color, n), vdbsplat::adviseWritten(spread, n), vdbsplat::adviseWritten(members, n);
-    if (withDepthSpread) vdbsplat::adviseWritten(depthSpread, n);
+    resizeWritten(viewPos, n), resizeWritten(distance, n), resizeWritten(sigma, n), resizeWritten(color, n);
+    resizeWritten(spread, n), resizeWritten(depthSpread, withDepthSpread ? n : 0), resizeWritten(members, n);
 }
 
 void VoxelBatch::reserve(size_t n, bool depthSpreads) {
@@ -573,6 +561,8 @@ void VoxelStream::prepareMomentCache(size_t blocks) {
         const bool kept = level >= 2 || cache.level1;
         std::remove_reference_t<decltype(cache.cells[0])>().swap(cache.cells[level - 1]);  // the old grid's slots go
         cache.cells[level - 1].resize(kept ? room(cells) : 0);
+        // Claimed from the front and kept from render to render: huge pages where it is large.
+        adviseWritten(cache.cells[level - 1], cache.cells[level - 1].size());
         cache.offset[level - 1].resize(kept ? blocks : 0);
         cache.mask[level - 1].resize(kept ? blocks : 0);
         cache.have[level - 1].assign(kept ? blocks : 0, 0);

@@ -61,9 +61,8 @@ struct VoxelBatch {
     int64_t slabEnd = 0;             ///< one past the last slab
     size_t size() const { return viewPos.size(); }
     void clear();           ///< empties every array, keeping their capacity
-    void resize(size_t n);  ///< every array to @p n records
+    void resize(size_t n);  ///< every array to @p n records (resizeWritten: advised for huge pages where large)
     void reserve(size_t n, bool depthSpreads);  ///< room for @p n records in every array (no pages touched)
-    void adviseWritten(size_t n);  ///< the first @p n records of every array are about to be written (util/huge_pages.h)
 };
 
 /// Level of detail: the largest spread a uniform cell would add, s²(n² − 1)/12, as a fraction of

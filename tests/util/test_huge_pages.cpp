@@ -96,13 +96,18 @@ std::optional<bool> advisedHuge(const void* address) {
     return std::nullopt;
 }
 
-// A window that writes a little of a large block takes ordinary pages: a huge page is cleared whole
-// at its first touch. The huge pages the written part fills at least half of are advised.
-TEST(HugePages, OnlyTheWrittenHugePagesAreAdvised) {
+/// Whether this kernel takes madvise(MADV_HUGEPAGE) (it fails without transparent huge pages).
+bool hugePagesAdvisable() {
     void* probe = huge_pages::map(huge_pages::kHugePage);
     const bool supported = madvise(probe, huge_pages::kHugePage, MADV_HUGEPAGE) == 0;
     munmap(probe, huge_pages::kHugePage);
-    if (!supported) GTEST_SKIP() << "madvise(MADV_HUGEPAGE) is not supported here";
+    return supported;
+}
+
+// A window that writes a little of a large block takes ordinary pages: a huge page is cleared whole
+// at its first touch. The huge pages the written part fills at least half of are advised.
+TEST(HugePages, OnlyTheWrittenHugePagesAreAdvised) {
+    if (!hugePagesAdvisable()) GTEST_SKIP() << "madvise(MADV_HUGEPAGE) is not supported here";
     std::vector<uint32_t, HugePageAllocator<uint32_t>> v;
     growDiscarding(v, 200'000);  // 800 kB to write, 3.2 MB mapped: less than half a huge page
     ASSERT_EQ(reinterpret_cast<uintptr_t>(v.data()) % huge_pages::kHugePage, 0u);
@@ -112,6 +117,24 @@ TEST(HugePages, OnlyTheWrittenHugePagesAreAdvised) {
     growDiscarding(v, 300'000);  // 1.2 MB: more than half of the first huge page, none of the second
     EXPECT_EQ(advisedHuge(v.data()), std::optional<bool>(true));
     EXPECT_EQ(advisedHuge(v.data() + huge_pages::kHugePage / sizeof(uint32_t)), std::optional<bool>(false));
+}
+
+// The window's pending voxels grow past their room keeping what they hold; the new block is advised
+// before the copy, so the copy itself takes huge pages.
+TEST(HugePages, ResizeWrittenKeepsTheContentsAndAdvisesTheNewBlock) {
+    std::vector<uint32_t, HugePageAllocator<uint32_t>> v;
+    resizeWritten(v, 1000);
+    std::iota(v.begin(), v.end(), 7u);
+    resizeWritten(v, size_t(2) << 20);  // 8 MB: past the capacity, into a mapped block
+    ASSERT_EQ(v.size(), size_t(2) << 20);
+    for (uint32_t i = 0; i < 1000; ++i) ASSERT_EQ(v[i], 7u + i);
+    if (const std::optional<bool> advised = advisedHuge(v.data() + (size_t(1) << 20)); advised && hugePagesAdvisable()) {
+        EXPECT_TRUE(*advised);
+    }
+    resizeWritten(v, 10);  // shrinks the size, keeps the block
+    EXPECT_EQ(v.size(), 10u);
+    EXPECT_EQ(v[9], 16u);
+    EXPECT_GE(v.capacity(), size_t(2) << 20);
 }
 
 }  // namespace
