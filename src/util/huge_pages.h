@@ -17,7 +17,6 @@
 #include <sys/mman.h>
 
 #include <algorithm>
-
 #include <cstddef>
 #include <new>
 #include <type_traits>
@@ -46,9 +45,9 @@ inline void* map(std::size_t bytes) {
 /// @brief Advises huge pages for the huge pages of a block from map() (which starts on a
 /// huge-page boundary) that its first @p bytes, the part a caller is about to write, fill at least
 /// half of. Memory is mapped unadvised: a huge page costs its whole 2 MiB at the first touch (cleared
-/// by the kernel, and on a paravirtualised host backed by the host too: 1.3–3.3 ms cold here), and a
-/// window that writes 100 KiB of a buffer reserved for 2^18 records paid that for each of its
-/// arrays; a 4 KiB page costs ~11 µs (docs/performance.md, session 30).
+/// by the kernel, and on a paravirtualised host backed by the host too: 1.3–6 ms cold on the hosts
+/// measured), and a window that writes 100 KiB of a buffer reserved for 2^18 records paid that for
+/// each of its arrays; a 4 KiB page costs 2–11 µs there (docs/performance.md, sessions 29, 30).
 inline void adviseWritten(void* p, std::size_t bytes) {
     const std::size_t pages = (bytes + kHugePage / 2) / kHugePage;
     if (pages > 0) madvise(p, pages * kHugePage, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
