@@ -159,6 +159,7 @@ TileCompositor::~TileCompositor() = default;
 
 Image TileCompositor::image() const {
     Image image(width_, height_);
+    adviseRowsWritten(image, 0, height_, width_);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, image.pixels.size(), 16384), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) image.pixels[i] = glm::vec4(color_[i], 1.f - transmittance_[i]);
     });

@@ -20,7 +20,8 @@ namespace vdbsplat {
 /// Allocates zeroed memory (calloc) and value-initialises elements by leaving them as they are: a
 /// vector sized once on this allocator is all zeros without writing them, and a large one is pages
 /// the kernel maps as zeros when first touched (a far view's 1024² output image: 16 MB of which
-/// the render writes a few rows, and writing the PNG only reads). Only for vectors sized once, at
+/// the render writes a few rows, and writing the PNG only reads; the writers advise huge pages for
+/// what they write, adviseRowsWritten below). Only for vectors sized once, at
 /// construction: a vector shrunk and grown again would keep stale elements. @tparam T trivial.
 template <class T>
 struct ZeroedAllocator {
@@ -36,11 +37,7 @@ struct ZeroedAllocator {
     static constexpr size_t kMapBytes = size_t(1) << 20;
     T* allocate(size_t n) {
         if (n > size_t(-1) / sizeof(T)) throw std::bad_alloc();
-        if (n * sizeof(T) >= kMapBytes) {
-            void* p = huge_pages::map(huge_pages::roundUp(n * sizeof(T)));
-            huge_pages::adviseWritten(p, n * sizeof(T));
-            return static_cast<T*>(p);
-        }
+        if (n * sizeof(T) >= kMapBytes) return static_cast<T*>(huge_pages::map(huge_pages::roundUp(n * sizeof(T))));
         if (void* p = std::calloc(n, sizeof(T))) return static_cast<T*>(p);
         throw std::bad_alloc();
     }
@@ -69,6 +66,20 @@ struct Image {
     glm::vec4& at(int x, int y) { return pixels[size_t(y) * width + x]; }
     const glm::vec4& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
 };
+
+/// @brief Advises huge pages (huge_pages::adviseWritten) for the rows [@p y0, @p y0 + @p rows) of
+/// @p image, which the caller is about to write @p columns of each, if that is at least half of
+/// each row: a far view's crop writes a few hundred pixels of a 1024-pixel row, and a huge page of
+/// those rows would be cleared whole for them (docs/performance.md, session 30). An image under
+/// ZeroedAllocator::kMapBytes is calloc'ed: nothing to advise.
+inline void adviseRowsWritten(Image& image, int y0, int rows, int columns) {
+    const size_t rowBytes = size_t(image.width) * sizeof(glm::vec4);
+    if (image.pixels.size() * sizeof(glm::vec4) < ZeroedAllocator<glm::vec4>::kMapBytes || rows <= 0 || 2 * size_t(columns) < size_t(image.width))
+        return;
+    // From the huge page the first row starts in (the block starts on a huge-page boundary).
+    const size_t first = size_t(y0) * rowBytes / huge_pages::kHugePage * huge_pages::kHugePage;
+    huge_pages::adviseWritten(reinterpret_cast<char*>(image.pixels.data()) + first, (size_t(y0) + size_t(rows)) * rowBytes - first);
+}
 
 /// @brief A composited frame where the compositor keeps it (premultiplied radiance and
 /// transmittance T per pixel, row-major), read as RGBA with α = 1 − T without copying it into an

@@ -193,6 +193,7 @@ double subpixelThreshold(double threshold, int k) {
 /// the rows copied in parallel; the rest is the image's zero pages, never touched.
 Image placed(const FrameView& frame, int x0, int y0, int width, int height) {
     Image out(width, height);
+    adviseRowsWritten(out, y0, frame.height, frame.width);
     tbb::parallel_for(tbb::blocked_range<int>(0, frame.height, 16), [&](const tbb::blocked_range<int>& r) {
         for (int y = r.begin(); y < r.end(); ++y)
             for (int x = 0; x < frame.width; ++x) out.at(x0 + x, y0 + y) = frame.at(x, y);

@@ -66,6 +66,7 @@ void filterBands(const Frame& fine, const SubpixelGrid& grid, int width, int hei
         throw Error("postfilter: the sub-pixel image does not match the grid");
     if (width < 0 || height < 0 || x0 < 0 || y0 < 0 || x0 + width > out.width || y0 + height > out.height)
         throw Error("postfilter: the output rectangle lies outside the image");
+    adviseRowsWritten(out, y0, height, width);
     constexpr int kBand = 16;  // output rows a band (a simple partition: exactly this many, the last fewer)
     tbb::enumerable_thread_specific<std::vector<glm::vec4>> buffers;
     tbb::parallel_for(

@@ -364,6 +364,7 @@ Image renderReference(const Volume& volume, const ClassificationTable& table, co
     // Output rows per band, so a band's samples stay under ~128 MiB.
     const int bandRows = std::clamp(int((128.0 * (1 << 20)) / bytesPerRow) - 2 * border, 1, H);
     Image image(W, H);
+    adviseRowsWritten(image, 0, H, W);
     const ActiveRegions regions(*volume.tree);
     std::vector<glm::vec4> samples;
     const double cutoff2 = kPrefilterCutoffSigmas * kPrefilterCutoffSigmas * kPrefilterVariance;

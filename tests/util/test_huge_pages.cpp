@@ -9,12 +9,13 @@
 
 #include <cstdint>
 #include <fstream>
-#include <sstream>
-#include <string>
 #include <numeric>
 #include <optional>
+#include <sstream>
+#include <string>
 #include <vector>
 
+#include "image/image.h"
 #include "util/huge_pages.h"
 
 namespace vdbsplat {
@@ -135,6 +136,24 @@ TEST(HugePages, ResizeWrittenKeepsTheContentsAndAdvisesTheNewBlock) {
     EXPECT_EQ(v.size(), 10u);
     EXPECT_EQ(v[9], 16u);
     EXPECT_GE(v.capacity(), size_t(2) << 20);
+}
+
+// A far view's crop writes a few hundred pixels of each of its rows: those rows stay in small
+// pages. A crop as wide as the image (a framed view) takes huge pages for its rows.
+TEST(HugePages, AnImageIsAdvisedWhereItsRowsAreMostlyWritten) {
+    if (!hugePagesAdvisable()) GTEST_SKIP() << "madvise(MADV_HUGEPAGE) is not supported here";
+    Image narrow(1024, 1024);  // 16 MB, mapped: a row is 16 kB, a huge page 128 rows
+    ASSERT_EQ(reinterpret_cast<uintptr_t>(narrow.pixels.data()) % huge_pages::kHugePage, 0u);
+    adviseRowsWritten(narrow, 300, 400, 300);  // 300 of 1024 columns
+    const std::optional<bool> before = advisedHuge(&narrow.at(0, 400));
+    if (!before) GTEST_SKIP() << "/proc/self/smaps cannot be read";
+    EXPECT_FALSE(*before);
+    Image wide(1024, 1024);
+    adviseRowsWritten(wide, 300, 400, 1000);  // rows 300 … 699: huge pages 2 … 5 (rows 256 … 767)
+    EXPECT_EQ(advisedHuge(&wide.at(0, 400)), std::optional<bool>(true));
+    EXPECT_EQ(advisedHuge(&wide.at(0, 300)), std::optional<bool>(true));
+    EXPECT_EQ(advisedHuge(&wide.at(0, 100)), std::optional<bool>(false));  // huge page 0: not written
+    EXPECT_EQ(advisedHuge(&wide.at(0, 900)), std::optional<bool>(false));
 }
 
 }  // namespace
