@@ -64,7 +64,8 @@ struct Primitive {
     SlabProfile profile;
 };
 
-/// The projected window: reused window after window, in huge pages (util/huge_pages.h).
+/// The projected window: reused window after window, in huge pages where a window fills them
+/// (util/huge_pages.h).
 using PrimitiveBuffer = std::vector<Primitive, HugePageAllocator<Primitive>>;
 
 /// What the tile loop reads of one primitive, in one 64-byte line (gsplat: sort keys, not
@@ -100,7 +101,7 @@ inline uint64_t tileRect(const PixelRange& r) {
 }
 
 /// A window of primitives, structure of arrays, element i from voxel i of the batch. Reused
-/// window after window (the buffers grow only), in huge pages.
+/// window after window (the buffers grow only), in huge pages where a window fills them.
 struct ProjectedWindow {
     template <class T>
     using Buffer = std::vector<T, HugePageAllocator<T>>;
