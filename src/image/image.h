@@ -76,9 +76,7 @@ inline void adviseRowsWritten(Image& image, int y0, int rows, int columns) {
     const size_t rowBytes = size_t(image.width) * sizeof(glm::vec4);
     if (image.pixels.size() * sizeof(glm::vec4) < ZeroedAllocator<glm::vec4>::kMapBytes || rows <= 0 || 2 * size_t(columns) < size_t(image.width))
         return;
-    // From the huge page the first row starts in (the block starts on a huge-page boundary).
-    const size_t first = size_t(y0) * rowBytes / huge_pages::kHugePage * huge_pages::kHugePage;
-    huge_pages::adviseWritten(reinterpret_cast<char*>(image.pixels.data()) + first, (size_t(y0) + size_t(rows)) * rowBytes - first);
+    huge_pages::adviseWritten(image.pixels.data(), size_t(y0) * rowBytes, (size_t(y0) + size_t(rows)) * rowBytes);
 }
 
 /// @brief A composited frame where the compositor keeps it (premultiplied radiance and

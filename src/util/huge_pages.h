@@ -43,14 +43,19 @@ inline void* map(std::size_t bytes) {
     return reinterpret_cast<void*>(aligned);
 }
 /// @brief Advises huge pages for the huge pages of a block from map() (which starts on a
-/// huge-page boundary) that its first @p bytes, the part a caller is about to write, fill at least
-/// half of. Memory is mapped unadvised: a huge page costs its whole 2 MiB at the first touch (cleared
-/// by the kernel, and on a paravirtualised host backed by the host too: 1.3–6 ms cold on the hosts
-/// measured), and a window that writes 100 KiB of a buffer reserved for 2^18 records paid that for
-/// each of its arrays; a 4 KiB page costs 2–11 µs there (docs/performance.md, sessions 29, 30).
-inline void adviseWritten(void* p, std::size_t bytes) {
-    const std::size_t pages = (bytes + kHugePage / 2) / kHugePage;
-    if (pages > 0) madvise(p, pages * kHugePage, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
+/// huge-page boundary) that the bytes [@p from, @p to) of it, the part a caller is about to write,
+/// fill at least half of. Memory is mapped unadvised: a huge page costs its whole 2 MiB at the first
+/// touch (cleared by the kernel, and on a paravirtualised host backed by the host too: 1.3–6 ms cold
+/// on the hosts measured), and a window that writes 100 KiB of a buffer reserved for 2^18 records
+/// paid that for each of its arrays; a 4 KiB page costs 2–11 µs there (docs/performance.md,
+/// sessions 29, 30). Only the two end pages can be partly written.
+inline void adviseWritten(void* block, std::size_t from, std::size_t to) {
+    if (to <= from) return;
+    std::size_t first = from / kHugePage, last = (to - 1) / kHugePage;
+    if (std::min(to, (first + 1) * kHugePage) - from < kHugePage / 2) ++first;
+    if (last >= first && to - std::max(from, last * kHugePage) < kHugePage / 2) --last;
+    if (last + 1 > first)  // advice only: failure leaves ordinary pages
+        madvise(static_cast<char*>(block) + first * kHugePage, (last + 1 - first) * kHugePage, MADV_HUGEPAGE);
 }
 }  // namespace huge_pages
 
@@ -98,7 +103,7 @@ struct HugePageAllocator {
 template <class Buffer>
 void adviseWritten(Buffer& buffer, std::size_t n) {
     constexpr std::size_t kSize = sizeof(typename Buffer::value_type);
-    if (buffer.capacity() * kSize >= huge_pages::kHugePage) huge_pages::adviseWritten(buffer.data(), std::min(n, buffer.capacity()) * kSize);
+    if (buffer.capacity() * kSize >= huge_pages::kHugePage) huge_pages::adviseWritten(buffer.data(), 0, std::min(n, buffer.capacity()) * kSize);
 }
 
 /// @brief Resizes @p buffer to @p n elements, keeping its contents, with its first n advised
@@ -113,9 +118,10 @@ void resizeWritten(Buffer& buffer, std::size_t n) {
         adviseWritten(bigger, n);
         bigger.assign(buffer.begin(), buffer.end());
         buffer.swap(bigger);
+    } else {
+        adviseWritten(buffer, n);
     }
     buffer.resize(n);
-    adviseWritten(buffer, n);
 }
 
 /// @brief Grows @p buffer to at least @p n elements without keeping its contents (a window's

@@ -154,6 +154,11 @@ TEST(HugePages, AnImageIsAdvisedWhereItsRowsAreMostlyWritten) {
     EXPECT_EQ(advisedHuge(&wide.at(0, 300)), std::optional<bool>(true));
     EXPECT_EQ(advisedHuge(&wide.at(0, 100)), std::optional<bool>(false));  // huge page 0: not written
     EXPECT_EQ(advisedHuge(&wide.at(0, 900)), std::optional<bool>(false));
+    Image edge(1024, 1024);
+    adviseRowsWritten(edge, 120, 200, 1024);  // rows 120 … 319: 8 of huge page 0's 128 rows, all of 1's, 64 of 2's
+    EXPECT_EQ(advisedHuge(&edge.at(0, 50)), std::optional<bool>(false));  // an end page written less than half
+    EXPECT_EQ(advisedHuge(&edge.at(0, 200)), std::optional<bool>(true));
+    EXPECT_EQ(advisedHuge(&edge.at(0, 300)), std::optional<bool>(true));  // exactly half
 }
 
 }  // namespace
