@@ -15,13 +15,16 @@ Usage (from the project root, after a build; vs-vtk.py's packages: python3-vtk9 
 python3-numpy xvfb xauth):
 
   scripts/vs-vtk-rounds.py [--build NAME=BIN ...] [--volume FILE.vdb:TF ...] [--rounds 3]
-      [--runs 7] [--sizes 400,1024] [--distances 8,1,0.35] [--threads 2] [--out out/vs-vtk-rounds]
+      [--runs 7] [--sizes 400,1024] [--distances 8,1,0.35] [--threads 2] [--extra "FLAGS"]
+      [--out out/vs-vtk-rounds]
   scripts/vs-vtk-rounds.py --summarize [--out DIR]    # the tables again, from DIR's CSVs
   scripts/vs-vtk-rounds.py --self-test                # checks the statistics on made-up rounds
 
 Defaults: --build build=build/vdbsplat; --volume volumes/engine.vdb:ct-bone and
 volumes/checkerbox.vdb:grey. Without a DISPLAY, each vs-vtk.py run goes through xvfb-run.
 Each round's CSV is DIR/BUILD/VOLUME/roundN/vs-vtk.csv (vs-vtk.py's own, with its PNGs).
+--extra goes to vs-vtk.py's --extra (more render flags): --extra "--warmup 1" times a second render
+in the same process, as VTK's side is timed (warm); without it each render is a fresh process.
 """
 import argparse
 import csv
@@ -165,6 +168,8 @@ def run_rounds(a):
                 out = os.path.join(a.out, name, volume, f"round{r}")
                 cmd = prefix + ["/usr/bin/python3", vs_vtk, binary, path, "--tf", tf, "--distances", a.distances,
                                 "--sizes", a.sizes, "--runs", str(a.runs), "--threads", str(a.threads), "--out", out]
+                if a.extra:
+                    cmd += ["--extra", a.extra]
                 print(f"round {r}/{a.rounds}: {name} {volume}", file=sys.stderr, flush=True)
                 done = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
                 if done.returncode != 0:
@@ -200,6 +205,7 @@ def main():
     ap.add_argument("--sizes", default="400,1024")
     ap.add_argument("--distances", default="8,1,0.35")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--extra", default="", help="more vdbsplat render flags, one string (vs-vtk.py --extra)")
     ap.add_argument("--out", default="out/vs-vtk-rounds")
     ap.add_argument("--vs-vtk", default=os.path.join(ROOT, "..", "shared", "tools", "vs-vtk.py"))
     ap.add_argument("--summarize", action="store_true", help="only print the tables of --out's CSVs")
