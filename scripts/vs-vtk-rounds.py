@@ -28,6 +28,7 @@ in the same process, as VTK's side is timed (warm); without it each render is a 
 """
 import argparse
 import csv
+import glob
 import os
 import random
 import shutil
@@ -65,18 +66,17 @@ def bar_for(distance, distances):
 
 def read_rounds(out):
     """{(build, volume): [rows of each round]} from out/BUILD/VOLUME/roundN/vs-vtk.csv."""
-    found = {}
     if not os.path.isdir(out):
         sys.exit(f"vs-vtk-rounds: error: {out}: no such directory")
-    for build in sorted(os.listdir(out)):
-        for volume in sorted(os.listdir(os.path.join(out, build))) if os.path.isdir(os.path.join(out, build)) else []:
-            base = os.path.join(out, build, volume)
-            rounds = sorted((d for d in os.listdir(base) if d.startswith("round")), key=lambda d: int(d[5:]))
-            for r in rounds:
-                path = os.path.join(base, r, "vs-vtk.csv")
-                if os.path.exists(path):
-                    with open(path, newline="") as f:
-                        found.setdefault((build, volume), []).append(list(csv.DictReader(f)))
+    found = {}
+    paths = [p for p in glob.glob(os.path.join(out, "*", "*", "round*", "vs-vtk.csv"))
+             if os.path.basename(os.path.dirname(p))[5:].isdigit()]
+    round_of = lambda path: int(os.path.basename(os.path.dirname(path))[5:])
+    for path in sorted(paths, key=lambda p: (os.path.dirname(os.path.dirname(p)), round_of(p))):
+        volume_dir = os.path.dirname(os.path.dirname(path))
+        key = (os.path.basename(os.path.dirname(volume_dir)), os.path.basename(volume_dir))
+        with open(path, newline="") as f:
+            found.setdefault(key, []).append(list(csv.DictReader(f)))
     if not found:
         sys.exit(f"vs-vtk-rounds: error: {out}: no round CSVs (BUILD/VOLUME/roundN/vs-vtk.csv)")
     return found

@@ -145,22 +145,21 @@ struct ProjectedWindow {
         q.range = p.range;
         q.kind = p.kind;
         q.hasExactMap = p.hasExactMap;
-        place(i, p.kind, p.range, p.slab, p.depth, p.members);
+        place(i, p.slab, p.depth, p.members);
         if (needsExtra(p.kind)) extra[i] = PrimitiveExtra{p.exactMap, p.viewPos, p.sigma};
         if (profiles) profile[i] = p.profile;
     }
     /// The rest of primitive @p i once records[i] holds all but its slab (set() does this; the
     /// projection's lane path writes its splats' records in place and then calls this, without
     /// building a Primitive: a record built aside and copied stalled on store forwarding):
-    /// its slab @p absoluteSlab, its order key, @p distance and @p voxels. @p kind and @p range
-    /// are the record's own, passed by value: read back from the record just written, the range
-    /// waited on its store (12 % of the projection's scalar loop at the framed Engine).
-    void place(size_t i, PrimitiveKind kind, const PixelRange& range, int64_t absoluteSlab, float distance, uint32_t voxels) {
+    /// its slab @p absoluteSlab, its order key, @p distance and @p voxels.
+    void place(size_t i, int64_t absoluteSlab, float distance, uint32_t voxels) {
+        PrimitiveRecord& q = records[i];
         const uint32_t slab = uint32_t(std::clamp<int64_t>(absoluteSlab - slabBase, 0, kMaxRelativeSlab));
-        records[i].slab = slab;
-        const bool drawn = kind != PrimitiveKind::Culled && !range.empty();
-        order[i] = drawn ? slab << 1 | (kind == PrimitiveKind::Point ? 0u : 1u) : kNotDrawn;
-        if (drawn) tiles[i] = tileRect(range);
+        q.slab = slab;
+        const bool drawn = q.kind != PrimitiveKind::Culled && !q.range.empty();
+        order[i] = drawn ? slab << 1 | (q.kind == PrimitiveKind::Point ? 0u : 1u) : kNotDrawn;
+        if (drawn) tiles[i] = tileRect(q.range);
         depth[i] = distance;
         members[i] = voxels;
     }
