@@ -1,5 +1,5 @@
-// image/image.cpp — PNG output through libpng (sRGB codes by table; Paeth filter, run-length
-// deflate) and EXR output through OpenEXR, atomic via rename (through a symbolic link to its
+// image/image.cpp — PNG output (image/png_writer.h: sRGB codes by table, Paeth filter, run-length
+// deflate, bands in parallel) and EXR output through OpenEXR, atomic via rename (through a symbolic link to its
 // target; never over a device node), and the bounded, checked input of `compare` (a PNG or EXR
 // by content, one flat 2D image, bounded in size, checked before any pixel is read). The two
 // libraries are used directly, not through OpenImageIO: its 230 shared libraries (codecs,
@@ -24,16 +24,15 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cerrno>
 #include <cmath>
-#include <csetjmp>
 #include <cstdio>
 #include <cstring>
 #include <exception>
 #include <filesystem>
 #include <unistd.h>
 
+#include "image/png_writer.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 #include "util/parse.h"
@@ -99,98 +98,15 @@ struct PngImage {
     std::string message() const { return image.message[0] ? std::string(image.message) : "unknown libpng error"; }
 };
 
-/// 8-bit sRGB codes, lround(255·linearToSrgb(v)), by table: the code is non-decreasing in v,
-/// so it is the number of codes k ≥ 1 whose threshold — the least float with that code or more
-/// — is at most v, found by an 8-step binary search instead of a powf per channel (3 M of them
-/// for a 1024² image: 45–80 ms). The same code for every float: every float of [0, 1] checked
-/// against the formula (docs/performance.md, session 17); NaN and v ≤ 0 give 0, v ≥ 1 gives 255.
-class SrgbEncoder {
-public:
-    SrgbEncoder() {
-        first_[0] = -INFINITY;
-        for (int k = 1; k < 256; ++k) {
-            // The least non-negative float (ordered as its bits) whose code is at least k.
-            uint32_t lo = 0, hi = 0x3f800000u;  // code(0) = 0 < k ≤ 255 = code(1)
-            while (lo + 1 < hi) {
-                const uint32_t mid = lo + (hi - lo) / 2;
-                (code(std::bit_cast<float>(mid)) >= k ? hi : lo) = mid;
-            }
-            first_[size_t(k)] = std::bit_cast<float>(hi);
-        }
-    }
-    /// The formula itself (the oracle of the table; image.h's linearToSrgb, rounded).
-    static int code(float v) { return int(static_cast<png_byte>(std::lround(255.0f * linearToSrgb(v)))); }
-    png_byte operator()(float v) const {
-        if (!(v > 0.f)) return 0;  // NaN too, as the formula's lround(NaN) cast to a byte
-        int k = 0;
-        for (int step = 128; step > 0; step >>= 1)
-            if (v >= first_[size_t(k + step)]) k += step;
-        return png_byte(k);
-    }
-
-private:
-    std::array<float, 256> first_;
-};
-
-const SrgbEncoder& srgbEncoder() {
-    static const SrgbEncoder encoder;  // 255 binary searches, ~0.1 ms, once per process
-    return encoder;
-}
-
-/// libpng's error callback: the message kept, then back to encodeRgbRows' setjmp.
-void onPngError(png_structp png, png_const_charp message) {
-    auto* out = static_cast<std::array<char, 256>*>(png_get_error_ptr(png));
-    std::snprintf(out->data(), out->size(), "%s", message ? message : "libpng error");
-    png_longjmp(png, 1);
-}
-void onPngWarning(png_structp, png_const_charp) {}
-
-/// Writes @p height rows of 8-bit RGB to @p file as a PNG: IHDR, the sRGB chunk (as libpng's
-/// simplified writer, used before, wrote it), and the rows with the Paeth filter and zlib's
-/// run-length strategy. That encodes 2–5× faster than the simplified writer's adaptive filters
-/// and default deflate, for files 11–64 % larger (docs/performance.md, session 17). Only plain
-/// locals here: libpng reports errors by longjmp. False with @p message set on error.
-bool encodeRgbRows(std::FILE* file, const png_byte* rgb, png_uint_32 width, png_uint_32 height,
-                   std::array<char, 256>& message) {
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &message, onPngError, onPngWarning);
-    if (!png) return std::snprintf(message.data(), message.size(), "out of memory"), false;
-    png_infop info = png_create_info_struct(png);
-    if (!info) {
-        png_destroy_write_struct(&png, nullptr);
-        return std::snprintf(message.data(), message.size(), "out of memory"), false;
-    }
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, &info);
-        return false;
-    }
-    png_init_io(png, file);
-    png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-                 PNG_FILTER_TYPE_DEFAULT);
-    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_PAETH);
-    png_set_compression_strategy(png, Z_RLE);
-    png_write_info(png, info);
-    for (png_uint_32 y = 0; y < height; ++y) png_write_row(png, rgb + size_t(y) * width * 3);
-    png_write_end(png, info);
-    png_destroy_write_struct(&png, &info);
-    return true;
-}
-
 void writePng(const std::string& tmp, const std::string& path, const Image& image) {
-    std::vector<png_byte> bytes(size_t(image.width) * image.height * 3);
-    const SrgbEncoder& encode = srgbEncoder();
-    for (size_t i = 0; i < image.pixels.size(); ++i)
-        for (int c = 0; c < 3; ++c) bytes[3 * i + c] = encode(image.pixels[i][c]);  // linearToSrgbCode
+    if (image.width < 1 || image.height < 1) throw Error(path + ": write failed: empty image");
+    const std::vector<uint8_t> bytes = encodePng(image);  // image/png_writer.h
     std::FILE* file = std::fopen(tmp.c_str(), "wb");
     if (!file) throw Error(path + ": write failed: " + std::strerror(errno));
-    std::array<char, 256> message{};
-    const bool encoded = encodeRgbRows(file, bytes.data(), png_uint_32(image.width), png_uint_32(image.height), message);
-    const bool flushed = std::ferror(file) == 0;
+    const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size() && std::fflush(file) == 0;
     const int err = errno;
-    if (std::fclose(file) != 0 && encoded && flushed)
-        throw Error(path + ": write failed: " + std::strerror(errno));
-    if (!encoded) throw Error(path + ": write failed: " + renamed(message.data(), tmp, path));
-    if (!flushed) throw Error(path + ": write failed: " + std::strerror(err));
+    if (std::fclose(file) != 0 && written) throw Error(path + ": write failed: " + std::strerror(errno));
+    if (!written) throw Error(path + ": write failed: " + std::strerror(err));
 }
 
 /// Sets OpenEXR's own header limits (it checks them while reading a header, before it
@@ -320,8 +236,6 @@ float linearToSrgb(float v) {
     v = std::clamp(v, 0.0f, 1.0f);
     return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
-
-uint8_t linearToSrgbCode(float v) { return srgbEncoder()(v); }
 
 float srgbToLinear(float v) {
     v = std::clamp(v, 0.0f, 1.0f);

@@ -1,6 +1,6 @@
 // image/image.h — the output image and its files.
 // Owns: Image (linear, premultiplied RGBA float, row-major, y down) and writing
-// it as PNG (8-bit, sRGB-encoded, over black; libpng) or EXR (float, linear, with
+// it as PNG (8-bit, sRGB-encoded, over black; image/png_writer.h) or EXR (float, linear, with
 // metadata; OpenEXR), atomically: a temporary file in the same folder, renamed into
 // place, so a failure never leaves a partial image; reading PNG or EXR back (`compare`).
 #pragma once
