@@ -1,6 +1,6 @@
 // image/image.cpp — PNG output (image/png_writer.h: sRGB codes by table, Paeth filter, run-length
-// deflate, bands in parallel) and EXR output through OpenEXR, atomic via rename (through a symbolic link to its
-// target; never over a device node), and the bounded, checked input of `compare` (a PNG or EXR
+// deflate, bands in parallel) and EXR output through OpenEXR, atomic via rename (through a
+// symbolic link to its target; never over a device node), and the bounded, checked input of `compare` (a PNG or EXR
 // by content, one flat 2D image, bounded in size, checked before any pixel is read). The two
 // libraries are used directly, not through OpenImageIO: its 230 shared libraries (codecs,
 // OpenCV, GDAL, ...) cost every vdbsplat process about 0.5 s of CPU and 100 MB before main()
@@ -19,8 +19,6 @@
 #include <IlmThread.h>
 #include <tbb/global_control.h>
 #include <png.h>
-
-#include <zlib.h>
 
 #include <algorithm>
 #include <array>

@@ -79,15 +79,25 @@ void put32(std::vector<uint8_t>& out, uint32_t v) {
     out.insert(out.end(), b, b + 4);
 }
 
-/// A chunk (PNG §5.3): length, type, data, CRC-32 of type and data.
+/// Opens a chunk (PNG §5.3) at the end of @p out: its length (set by closeChunk) and @p type.
+size_t openChunk(std::vector<uint8_t>& out, const char (&type)[5]) {
+    const size_t start = out.size();
+    put32(out, 0);
+    out.insert(out.end(), type, type + 4);
+    return start;
+}
+/// Closes the chunk opened at @p start, its data being the rest of @p out: the length, and the
+/// CRC-32 of type and data appended.
+void closeChunk(std::vector<uint8_t>& out, size_t start) {
+    const size_t size = out.size() - start - 8;
+    const uint8_t length[4] = {uint8_t(size >> 24), uint8_t(size >> 16), uint8_t(size >> 8), uint8_t(size)};
+    std::memcpy(out.data() + start, length, 4);
+    put32(out, uint32_t(crc32_z(crc32(0L, Z_NULL, 0), out.data() + start + 4, size + 4)));
+}
 void putChunk(std::vector<uint8_t>& out, const char (&type)[5], const uint8_t* data, size_t size) {
-    put32(out, uint32_t(size));
-    const auto* t = reinterpret_cast<const uint8_t*>(type);
-    out.insert(out.end(), t, t + 4);
+    const size_t start = openChunk(out, type);
     if (size) out.insert(out.end(), data, data + size);
-    uLong crc = crc32(crc32(0L, Z_NULL, 0), t, 4);
-    if (size) crc = crc32_z(crc, data, size);  // (a null buffer would return the initial value)
-    put32(out, uint32_t(crc));
+    closeChunk(out, start);
 }
 
 /// Row @p y of @p image as 8-bit sRGB codes over black (RGB).
@@ -154,7 +164,8 @@ void encodeBand(const Image& image, int y0, int y1, bool first, bool last, Defla
     z_stream& z = deflater.z;
     if (deflateReset(&z) != Z_OK) throw std::bad_alloc();
     std::vector<uint8_t>& out = band.chunk;
-    out.assign(8, 0);  // length and type, written below
+    out.clear();
+    const size_t chunk = openChunk(out, "IDAT");
     if (first) out.push_back(0x78), out.push_back(0x9c);  // zlib header: deflate, 32 KiB window, default level (RFC 1950)
     size_t used = out.size();
     out.resize(used + deflateBound(&z, uLong(filtered.size())) + 64);
@@ -171,11 +182,7 @@ void encodeBand(const Image& image, int y0, int y1, bool first, bool last, Defla
         out.resize(out.size() + out.size() / 2 + 64);  // more room than deflateBound promised: keep going
     }
     out.resize(used);
-    const size_t size = used - 8;
-    const uint8_t head[8] = {uint8_t(size >> 24), uint8_t(size >> 16), uint8_t(size >> 8), uint8_t(size), 'I', 'D', 'A', 'T'};
-    std::memcpy(out.data(), head, 8);
-    const uLong crc = crc32_z(crc32(0L, Z_NULL, 0), out.data() + 4, used - 4);
-    put32(out, uint32_t(crc));
+    closeChunk(out, chunk);
 }
 
 }  // namespace
