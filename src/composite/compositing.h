@@ -1,5 +1,7 @@
-// composite/compositing.h — the compositor's two orders of compositing (`--compositing`).
-// Owns: CompositingOrder and SlabCompositing, what the projection and the compositor agree on.
+// composite/compositing.h — the compositor's two orders of compositing (`--compositing`), and
+// its colour channels.
+// Owns: CompositingOrder, SlabCompositing and ColorChannels, what the renderer and the compositor
+// agree on.
 //   Kernels — DESIGN §4 as first built: each splat composited whole ("over") at its centre's
 //             depth, the points of one slab summed and composited when the slab ends;
 //   Slabs   — every primitive deposits its optical depth and σ-weighted colour into the radial
@@ -11,6 +13,13 @@
 namespace vdbsplat {
 
 enum class CompositingOrder { Kernels, Slabs };
+
+/// @brief The colour channels the compositor's vector loops carry. Grey: every primitive's colour
+/// is grey (c.x = c.y = c.z: a grey transfer function, unshaded, no emission), so compositing
+/// green and blue would repeat red's operations on red's values; the loops composite T and R
+/// alone and the frame's G and B are R. The image is the Rgb one bit for bit, for half the
+/// loads and stores of each deposit. The compositor takes it only in the kernel order.
+enum class ColorChannels { Rgb, Grey };
 
 /// @brief What the projection and the compositor share in the Slabs order.
 struct SlabCompositing {

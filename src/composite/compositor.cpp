@@ -129,9 +129,10 @@ struct TileCompositor::SlabRing {
 };
 
 TileCompositor::TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs,
-                               CompositorBuffers* buffers)
+                               CompositorBuffers* buffers, ColorChannels channels)
     : width_(width), height_(height), tilesX_((width + kTileSize - 1) / kTileSize),
       tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact), slabs_(slabs),
+      grey_(channels == ColorChannels::Grey && exact.vector && !slabs.on),
       own_(buffers ? nullptr : std::make_unique<CompositorBuffers>()), kept_(buffers ? *buffers : *own_),
       color_(kept_.color), transmittance_(kept_.transmittance), liveCount_(size_t(tilesX_) * tilesY_),
       binStart_(kept_.binStart), binEntries_(kept_.binEntries), binScratch_(kept_.binScratch), binCounts_(kept_.binCounts) {
@@ -340,7 +341,8 @@ struct TileCompositor::TilePixels {
         }
         return false;
     }
-    TileBuffers buffers() { return {T.data(), R.data(), G.data(), B.data(), x0, y0}; }
+    /// The vector loops' view; @p grey: T and R alone (ColorChannels::Grey).
+    TileBuffers buffers(bool grey) { return {T.data(), R.data(), grey ? nullptr : G.data(), grey ? nullptr : B.data(), x0, y0}; }
     /// α = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α   (DESIGN §4)
     void over(int i, float tau, const glm::vec3& color) {
         const float alpha = opacityFromOpticalDepth(tau);
@@ -367,11 +369,13 @@ void TileCompositor::loadTile(int tile, TilePixels& px) const {
     px.x1 = std::min(width_, px.x0 + kTileSize) - 1, px.y1 = std::min(height_, px.y0 + kTileSize) - 1;
     px.T.fill(0.f);  // pixels past the image's edge: finished (T = 0), never drawn
     px.R.fill(0.f), px.G.fill(0.f), px.B.fill(0.f);
+    // One channel: G and B stay 0 for the scalar paths' "over" (their G and B are dropped at store).
     for (int y = px.y0; y <= px.y1; ++y)
         for (int x = px.x0; x <= px.x1; ++x) {
             const size_t i = size_t(px.local(x, y)), k = size_t(y) * width_ + x;
             px.T[i] = transmittance_[k];
-            px.R[i] = color_[k].x, px.G[i] = color_[k].y, px.B[i] = color_[k].z;
+            px.R[i] = color_[k].x;
+            if (!grey_) px.G[i] = color_[k].y, px.B[i] = color_[k].z;
         }
 }
 
@@ -380,7 +384,7 @@ void TileCompositor::storeTile(int tile, const TilePixels& px) {
         for (int x = px.x0; x <= px.x1; ++x) {
             const size_t i = size_t(px.local(x, y)), k = size_t(y) * width_ + x;
             transmittance_[k] = px.T[i];
-            color_[k] = glm::vec3(px.R[i], px.G[i], px.B[i]);
+            color_[k] = grey_ ? glm::vec3(px.R[i]) : glm::vec3(px.R[i], px.G[i], px.B[i]);
         }
     // Each row's live pixels as bits, and their count (pixels past the image's edge hold T = 0:
     // never live).
@@ -521,7 +525,7 @@ void TileCompositor::closeSlab(TilePixels& px, SlabBuffer& slab, bool skipFinish
     }
     // The vector loop skips finished pixels too: in the kernel order there are none among a
     // slab's deposits (its points drew only live pixels, and nothing drew in between).
-    compositeSlabVector(slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.buffers(), kTransmittanceEpsilon,
+    compositeSlabVector(slab.tau.data(), slab.er.data(), slab.eg.data(), slab.eb.data(), px.buffers(grey_), kTransmittanceEpsilon,
                         slab.take(px.x0, px.y0, px.x1, px.y1));
     slab.dirty = false;
 }
@@ -557,7 +561,8 @@ void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBu
                       : drawPointSlabsScalar(r, *slabs, px.T.data(), px.x0, px.y0);
         return;
     }
-    const SlabTile tile{slab->tau.data(), slab->er.data(), slab->eg.data(), slab->eb.data(), px.T.data(), px.x0, px.y0};
+    const SlabTile tile{slab->tau.data(), slab->er.data(), grey_ ? nullptr : slab->eg.data(), grey_ ? nullptr : slab->eb.data(),
+                        px.T.data(), px.x0, px.y0};
     exact_.vector ? drawPointVector(r, tile) : drawPointScalar(r, tile);
     if (r.x0 <= r.x1 && r.y0 <= r.y1) slab->touch(r.x0, r.y0, r.x1, r.y1);
     slab->dirty = true;
@@ -597,7 +602,7 @@ void TileCompositor::drawSplat(const TileRecord& p, const ExactIndexMap& map, Ti
         s.y0 = std::max(p.range.y0, px.y0), s.y1 = std::min(p.range.y1, px.y1);
         s.epsilon = kTransmittanceEpsilon;
         s.slabs = slabs;
-        drawSplatVector(s, px.buffers());
+        drawSplatVector(s, px.buffers(grey_));
         return;
     }
     drawSplatTables(p, map, px, slabs);

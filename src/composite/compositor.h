@@ -79,8 +79,10 @@ struct CompositorBuffers {
 class TileCompositor {
 public:
     /// @param buffers where the large buffers live (kept by the caller across renders); null: its own.
+    /// @param channels Grey: every primitive's colour is grey (ColorChannels); taken with the vector
+    /// loops in the kernel order, else the compositor carries all three.
     TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs = {},
-                   CompositorBuffers* buffers = nullptr);
+                   CompositorBuffers* buffers = nullptr, ColorChannels channels = ColorChannels::Rgb);
     ~TileCompositor();
 
     /// @brief Composites @p window (one depth window, any order) behind everything before.
@@ -123,6 +125,9 @@ public:
     /// for the next window's primitives, whose kernels may reach back into them). Call it after
     /// the last window; nothing to do in the kernel order.
     void finish();
+
+    /// @brief The colour channels the vector loops carry: 1 (ColorChannels::Grey taken) or 3.
+    int channels() const { return grey_ ? 1 : 3; }
 
     /// @brief The image so far: premultiplied colour, alpha = 1 − T (after finish(): everything).
     Image image() const;
@@ -172,6 +177,7 @@ private:
     const Tables& tables_;
     ExactContext exact_;
     SlabCompositing slabs_;
+    bool grey_;  // ColorChannels::Grey taken: the vector loops composite T and R, storeTile copies R to G and B
     std::vector<std::unique_ptr<SlabRing>> rings_;  // --compositing slabs: per tile, null while none is open
     template <class T>
     using Buffer = CompositorBuffers::Buffer<T>;  // large: in huge pages (util/huge_pages.h)

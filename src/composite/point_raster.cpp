@@ -23,8 +23,9 @@ constexpr int kStride = kTileSize;  // tile row stride
 
 /// kSlabs false: the kernel order, into one slab's sums (@p tile); true: into @p slabs by their
 /// fractions. A template argument, so the kernel order's loop is the code it was before the slab
-/// order (through a one-slab SlabTargets it cost the far views' point loop 20 %).
-template <bool kSlabs, class D>
+/// order (through a one-slab SlabTargets it cost the far views' point loop 20 %). kGrey (the kernel
+/// order only): @p tile has no green and blue sums, only τ and the red one are written.
+template <bool kSlabs, bool kGrey, class D>
 void DrawPointFor(D d, const PointRaster& p, const SlabTargets* slabs, const SlabTile* tile, const float* T, int tileX0,
                   int tileY0) {
     using V = hn::Vec<D>;
@@ -60,11 +61,13 @@ void DrawPointFor(D d, const PointRaster& p, const SlabTargets* slabs, const Sla
             const auto deposit = [&](V tau, float* sumTau, float* sumR, float* sumG, float* sumB) {
                 float* const pt = sumTau + row + c;
                 float* const pr = sumR + row + c;
-                float* const pg = sumG + row + c;
-                float* const pb = sumB + row + c;
-                const V t0 = hn::Load(d, pt), r0v = hn::Load(d, pr), g0 = hn::Load(d, pg), b0 = hn::Load(d, pb);
+                const V t0 = hn::Load(d, pt), r0v = hn::Load(d, pr);
                 hn::Store(hn::IfThenElse(mask, hn::Add(t0, tau), t0), d, pt);
                 hn::Store(hn::IfThenElse(mask, hn::Add(r0v, hn::Mul(tau, cr)), r0v), d, pr);
+                if constexpr (kGrey) return;
+                float* const pg = sumG + row + c;
+                float* const pb = sumB + row + c;
+                const V g0 = hn::Load(d, pg), b0 = hn::Load(d, pb);
                 hn::Store(hn::IfThenElse(mask, hn::Add(g0, hn::Mul(tau, cg)), g0), d, pg);
                 hn::Store(hn::IfThenElse(mask, hn::Add(b0, hn::Mul(tau, cb)), b0), d, pb);
             };
@@ -88,7 +91,7 @@ constexpr int kPairLanes = 16;  // DrawPointPairs: two rows of 8 pixels per vect
 /// where one vector per row left half its lanes or more idle. The window's columns and the rows get
 /// their squared offsets and weights from AxisWeights, as DrawPointFor's; every pixel then takes
 /// DrawPointFor's operations, so the same sums bit for bit.
-template <bool kSlabs, class D>
+template <bool kSlabs, bool kGrey, class D>
 void DrawPointPairs(D d, const PointRaster& p, const SlabTargets* slabs, const SlabTile* tile, const float* T, int tileX0,
                     int tileY0) {
     using V = hn::Vec<D>;
@@ -121,9 +124,11 @@ void DrawPointPairs(D d, const PointRaster& p, const SlabTargets* slabs, const S
                 hn::StoreU(hn::LowerHalf(dh, value), dh, base + offA);
                 if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
             };
-            const V t0 = load(sumTau), r0 = load(sumR), g0 = load(sumG), b0 = load(sumB);
+            const V t0 = load(sumTau), r0 = load(sumR);
             store(sumTau, hn::IfThenElse(mask, hn::Add(t0, tau), t0));
             store(sumR, hn::IfThenElse(mask, hn::Add(r0, hn::Mul(tau, cr)), r0));
+            if constexpr (kGrey) return;
+            const V g0 = load(sumG), b0 = load(sumB);
             store(sumG, hn::IfThenElse(mask, hn::Add(g0, hn::Mul(tau, cg)), g0));
             store(sumB, hn::IfThenElse(mask, hn::Add(b0, hn::Mul(tau, cb)), b0));
         };
@@ -139,20 +144,21 @@ void DrawPointPairs(D d, const PointRaster& p, const SlabTargets* slabs, const S
 #endif  // HWY_TARGET != HWY_SCALAR
 
 /// The point's pixels in the tile: two rows a vector where vectors hold 16 floats, else one row.
-template <bool kSlabs>
+template <bool kSlabs, bool kGrey = false>
 void DrawPointIn(const PointRaster& p, const SlabTargets* slabs, const SlabTile* tile, const float* T, int x0, int y0) {
 #if HWY_TARGET != HWY_SCALAR
     using D16 = hn::CappedTag<float, kPairLanes>;
     if constexpr (hn::MaxLanes(D16()) == kPairLanes) {
         static_assert(kPointMaxSide <= kPairLanes / 2, "a point's columns fit half a vector");
-        if (hn::Lanes(D16()) == kPairLanes) return DrawPointPairs<kSlabs>(D16(), p, slabs, tile, T, x0, y0);
+        if (hn::Lanes(D16()) == kPairLanes) return DrawPointPairs<kSlabs, kGrey>(D16(), p, slabs, tile, T, x0, y0);
     }
 #endif
-    DrawPointFor<kSlabs>(hn::CappedTag<float, kStride>(), p, slabs, tile, T, x0, y0);
+    DrawPointFor<kSlabs, kGrey>(hn::CappedTag<float, kStride>(), p, slabs, tile, T, x0, y0);
 }
 
 void DrawPoint(const PointRaster& p, const SlabTile& tile) {
     if (p.x0 > p.x1 || p.y0 > p.y1) return;
+    if (!tile.eg) return DrawPointIn<false, true>(p, nullptr, &tile, tile.T, tile.x0, tile.y0);
     DrawPointIn<false>(p, nullptr, &tile, tile.T, tile.x0, tile.y0);
 }
 
@@ -202,6 +208,7 @@ void drawPointSlabsScalar(const PointRaster& p, const SlabTargets& slabs, const 
                 const float tau = tauAll * slabs.fraction[size_t(j)];
                 slabs.tau[size_t(j)][i] += tau;
                 slabs.er[size_t(j)][i] += tau * p.color.x;
+                if (!slabs.eg[size_t(j)]) continue;  // one channel
                 slabs.eg[size_t(j)][i] += tau * p.color.y;
                 slabs.eb[size_t(j)][i] += tau * p.color.z;
             }

@@ -21,11 +21,12 @@
 namespace vdbsplat {
 
 /// @brief One tile's slab buffer (optical depth and σ-weighted emission per channel) and its
-/// transmittance: row-major, stride kTileSize (composite/tile.h), 64-byte aligned arrays.
+/// transmittance: row-major, stride kTileSize (composite/tile.h), 64-byte aligned arrays. eg and eb
+/// null: one channel (ColorChannels::Grey), τ and er alone are written.
 struct SlabTile {
     float* tau;
     float* er;
-    float* eg;
+    float* eg;  ///< null with eb: one channel
     float* eb;
     const float* T;
     int x0 = 0, y0 = 0;  ///< image coordinates of the tile's first pixel

@@ -23,6 +23,12 @@ namespace hn = hwy::HWY_NAMESPACE;
 constexpr int kStride = kTileSize;  // tile row stride
 constexpr int kPairLanes = 16;  // DrawRowPairs: two rows of 8 pixels per vector (16-lane targets)
 
+/// Where a splat's deposits go, a template argument of every loop (so each is the code it would be
+/// alone: a branch per vector, with the other deposits inlined beside it, cost the kernel order 15 %
+/// when the slab order came): "over" the tile's four channels, "over" its T and R alone (TileBuffers
+/// without G and B: every colour grey, so G and B would be R), or the slab sums (--compositing slabs).
+enum class Sink { Over, OverGrey, Slabs };
+
 /// The exact d² = 1 − (1 − i²)/w from the affine index i² and the map's w at the same pixel
 /// (ExactIndexMap::d2), clamped at 0.
 template <class D, class V = hn::Vec<D>>
@@ -119,17 +125,20 @@ HWY_INLINE void DepositSlabs(D d, const SplatRaster& s, V tau, M mask, const Loa
 /// before its loop: read from the SplatRaster after the tile's stores it would be loaded again per
 /// vector, as the stores may alias it). @p load and @p store read and write one vector of a tile
 /// array at the lanes' pixels (one row's, or two rows' halves).
-template <bool kSlabs, class D, class V, class M, class Load, class Store>
+template <Sink kSink, class D, class V, class M, class Load, class Store>
 HWY_INLINE void Deposit(D d, const SplatRaster& s, const TileBuffers& tile, V tau, V T, M mask, const V (&rgb)[3],
                         const Load& load, const Store& store) {
-    if constexpr (kSlabs) {
+    if constexpr (kSink == Sink::Slabs) {
         DepositSlabs(d, s, tau, mask, load, store);
     } else {
         const V ta = hn::Mul(T, OpacityFromTau(d, tau, s.series));  // T·α
-        const V R = load(tile.R), G = load(tile.G), B = load(tile.B);
+        const V R = load(tile.R);
         store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[0], R), R));
-        store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[1], G), G));
-        store(tile.B, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[2], B), B));
+        if constexpr (kSink == Sink::Over) {
+            const V G = load(tile.G), B = load(tile.B);
+            store(tile.G, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[1], G), G));
+            store(tile.B, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[2], B), B));
+        }
         store(tile.T, hn::IfThenElse(mask, hn::Sub(T, ta), T));  // T·(1 − α)
     }
 }
@@ -194,7 +203,7 @@ HWY_INLINE void SetUpRows(D d, const SplatRaster& s, const TileBuffers& tile, Ro
 /// chords of a close-up's splats). A vector that would run past the row's end is moved back
 /// inside it, and its lanes the previous vector drew are masked off. The rows come prepared
 /// (SetUpRows): a vector costs its pixels' quadratics, the footprint and the deposit.
-template <bool kSlabs>
+template <Sink kSink>
 void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
     const hn::CappedTag<float, kStride> d;
     const int n = int(hn::Lanes(d));
@@ -230,7 +239,7 @@ void DrawRowsWide(const SplatRaster& s, const TileBuffers& tile) {
             const auto mask = hn::And(chord, hn::And(hn::Lt(i2, one), hn::Ge(T, eps)));
             if (hn::AllFalse(d, mask)) continue;
             const V tau = Tau(d, s, i2, [&] { return hn::MulAdd(hn::MulAdd(wxx, dx, hn::Set(d, q.w1[k])), dx, hn::Set(d, q.w0[k])); });
-            Deposit<kSlabs>(d, s, tile, tau, T, mask, rgb, [&](const float* base) { return hn::LoadU(d, base + row + c); },
+            Deposit<kSink>(d, s, tile, tau, T, mask, rgb, [&](const float* base) { return hn::LoadU(d, base + row + c); },
                             [&](float* base, V v) { hn::StoreU(v, d, base + row + c); });
         }
     }
@@ -256,7 +265,7 @@ struct RowWindows {
 /// for a splat a few pixels wide. Same per-pixel operations, so the same values. The rows' dy,
 /// window positions and chord masks come prepared (RowWindows), so a pair costs two broadcasts
 /// and a mask load before the footprint.
-template <bool kSlabs, class D>
+template <Sink kSink, class D>
 void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowWindows& w) {
     using V = hn::Vec<D>;
     const hn::Half<D> dh;
@@ -283,7 +292,7 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
             if (pair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
         const V tau = Tau(d, s, i2, [&] { return MapW(d, s.map, dx, dy); });
-        Deposit<kSlabs>(d, s, tile, tau, T, mask, rgb, load, store);
+        Deposit<kSink>(d, s, tile, tau, T, mask, rgb, load, store);
     }
 }
 
@@ -292,7 +301,7 @@ void DrawRowPairs(D d, const SplatRaster& s, const TileBuffers& tile, const RowW
 /// DrawRowPairs with nothing set up per row: the mask i² < 1 alone picks the ellipse's pixels (the
 /// chord would only skip lanes it rejects). Per splat, dx and the i² terms in dx alone are fixed:
 /// i² = Qxx dx² + (2 Qxy dx + Qyy dy)·dy, two FMAs a vector.
-template <bool kSlabs, class D>
+template <Sink kSink, class D>
 void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
     using V = hn::Vec<D>;
     const hn::Half<D> dh;
@@ -327,7 +336,7 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
             if constexpr (kPair) hn::StoreU(hn::UpperHalf(dh, value), dh, base + offB);
         };
         const V tau = Tau(d, s, i2, [&] { return hn::MulAdd(hn::MulAdd(wyy, dy, wCross), dy, wAlongX); });
-        Deposit<kSlabs>(d, s, tile, tau, T, mask, rgb, load, store);
+        Deposit<kSink>(d, s, tile, tau, T, mask, rgb, load, store);
     };
     V yPix = hn::Add(hn::Set(d, float(s.y0) + 0.5f), hn::Combine(d, hn::Set(dh, 1.f), hn::Zero(dh)));  // rows y, y + 1
     const V two = hn::Set(d, 2.f);
@@ -340,7 +349,7 @@ void DrawBoxPairs(D d, const SplatRaster& s, const TileBuffers& tile) {
 /// tile), and from them, in the same lanes, each row's 8-pixel window and chord mask; if the rows
 /// with a chord are one run (they are: an ellipse is convex) and every chord fits its window,
 /// draws them two by two (DrawRowPairs) and returns true.
-template <bool kSlabs, class D>
+template <Sink kSink, class D>
 bool DrawRowPairsIfNarrow(D d, const SplatRaster& s, const TileBuffers& tile) {
     constexpr int kHalf = kPairLanes / 2;
     const hn::RebindToSigned<D> di;
@@ -381,36 +390,38 @@ bool DrawRowPairsIfNarrow(D d, const SplatRaster& s, const TileBuffers& tile) {
     const VI ones = hn::Set(di, 1);
     const VI run8 = hn::Sub(hn::Shl(ones, hn::Add(width, ones)), ones);  // width + 1 low bits (≤ 8)
     hn::Store(hn::Shl(run8, hn::Sub(rel, start)), di, w.bits);
-    DrawRowPairs<kSlabs>(d, s, tile, w);
+    DrawRowPairs<kSink>(d, s, tile, w);
     return true;
 }
 
 #endif  // HWY_TARGET != HWY_SCALAR
 
-// The order is a template argument, so the kernel order's loops are the code they were before the
-// slab order (a branch per vector, with the slab deposit inlined beside it, cost 15 % there).
-template <bool kSlabs, class D>
+// The sink is a template argument (Sink), so each loop is the code it would be alone.
+template <Sink kSink, class D>
 void DrawSplatRowsFor(D d, const SplatRaster& s, const TileBuffers& tile) {
 #if HWY_TARGET != HWY_SCALAR
     // Splats up to 16 rows tall in the tile whose every chord fits 8 pixels: two rows a vector.
     if constexpr (hn::MaxLanes(D()) == kPairLanes) {
-        if (s.x1 - s.x0 < kPairLanes / 2) return DrawBoxPairs<kSlabs>(d, s, tile);
-        if (s.y1 - s.y0 + 1 <= kPairLanes && DrawRowPairsIfNarrow<kSlabs>(d, s, tile)) return;
+        if (s.x1 - s.x0 < kPairLanes / 2) return DrawBoxPairs<kSink>(d, s, tile);
+        if (s.y1 - s.y0 + 1 <= kPairLanes && DrawRowPairsIfNarrow<kSink>(d, s, tile)) return;
     }
 #else
     (void)d;
 #endif
-    DrawRowsWide<kSlabs>(s, tile);
+    DrawRowsWide<kSink>(s, tile);
 }
 
 void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) {
-    if (s.slabs) return DrawSplatRowsFor<true>(hn::CappedTag<float, kPairLanes>(), s, tile);
-    DrawSplatRowsFor<false>(hn::CappedTag<float, kPairLanes>(), s, tile);
+    const hn::CappedTag<float, kPairLanes> d;
+    if (s.slabs) return DrawSplatRowsFor<Sink::Slabs>(d, s, tile);
+    if (!tile.G) return DrawSplatRowsFor<Sink::OverGrey>(d, s, tile);
+    DrawSplatRowsFor<Sink::Over>(d, s, tile);
 }
 
 /// One slab over the live pixels of the tile's rectangle, then emptied there (compositeSlabVector):
 /// each row's vectors from the one holding the rectangle's first column (row starts are aligned).
-void CompositeSlab(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon, TileRect rect) {
+template <bool kGrey>
+void CompositeSlabFor(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon, TileRect rect) {
     const hn::CappedTag<float, kStride> d;
     using V = hn::Vec<decltype(d)>;
     const int n = int(hn::Lanes(d));
@@ -425,12 +436,21 @@ void CompositeSlab(float* tau, float* er, float* eg, float* eb, const TileBuffer
                 const V ta = hn::Mul(T, OpacityFromTau(d, t));  // T·α
                 const V w = hn::IfThenElseZero(mask, hn::Div(ta, hn::IfThenElse(mask, t, hn::Set(d, 1.f))));
                 hn::Store(hn::MulAdd(w, hn::Load(d, er + i), hn::Load(d, tile.R + i)), d, tile.R + i);
-                hn::Store(hn::MulAdd(w, hn::Load(d, eg + i), hn::Load(d, tile.G + i)), d, tile.G + i);
-                hn::Store(hn::MulAdd(w, hn::Load(d, eb + i), hn::Load(d, tile.B + i)), d, tile.B + i);
+                if constexpr (!kGrey) {
+                    hn::Store(hn::MulAdd(w, hn::Load(d, eg + i), hn::Load(d, tile.G + i)), d, tile.G + i);
+                    hn::Store(hn::MulAdd(w, hn::Load(d, eb + i), hn::Load(d, tile.B + i)), d, tile.B + i);
+                }
                 hn::Store(hn::IfThenElse(mask, hn::Sub(T, ta), T), d, tile.T + i);
             }
-            hn::Store(zero, d, tau + i), hn::Store(zero, d, er + i), hn::Store(zero, d, eg + i), hn::Store(zero, d, eb + i);
+            hn::Store(zero, d, tau + i), hn::Store(zero, d, er + i);
+            if constexpr (!kGrey) hn::Store(zero, d, eg + i), hn::Store(zero, d, eb + i);
         }
+}
+
+/// The slab over the tile's four channels, or (no G, B and no green and blue sums) over T and R alone.
+void CompositeSlab(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon, TileRect rect) {
+    if (!tile.G) return CompositeSlabFor<true>(tau, er, eg, eb, tile, epsilon, rect);
+    CompositeSlabFor<false>(tau, er, eg, eb, tile, epsilon, rect);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -474,8 +494,7 @@ void drawSplatScalarPoly(const SplatRaster& s, const TileBuffers& tile) {
             const float alpha = opacityFromOpticalDepth(tau);
             const float ta = tile.T[i] * alpha;
             tile.R[i] += ta * s.color.x;
-            tile.G[i] += ta * s.color.y;
-            tile.B[i] += ta * s.color.z;
+            if (tile.G) tile.G[i] += ta * s.color.y, tile.B[i] += ta * s.color.z;  // else one channel
             tile.T[i] -= ta;
         }
     }

@@ -25,10 +25,12 @@
 namespace vdbsplat {
 
 /// @brief One tile's pixels: row-major, stride kTileSize (composite/tile.h), 64-byte aligned arrays.
+/// G and B null: one channel (ColorChannels::Grey, every colour grey): the loops composite T and R
+/// alone, in the operations they give R with all four (and the slab order is not drawn this way).
 struct TileBuffers {
     float* T;          ///< transmittance
     float* R;          ///< premultiplied radiance, per channel
-    float* G;
+    float* G;          ///< null with B: one channel
     float* B;
     int x0 = 0, y0 = 0;  ///< image coordinates of the tile's first pixel
 };
@@ -77,6 +79,7 @@ struct TileRect {
 /// @p er, @p eg, @p eb (kTilePixels each) composited onto @p tile's live pixels (T ≥ @p epsilon),
 /// α = 1 − e^{−τ}, C += T·α·e/τ, T *= 1 − α; then the slab emptied there. The rectangle's columns
 /// are read in whole vectors: every pixel outside it must hold τ = 0 (it is left unchanged then).
+/// A @p tile without G and B (one channel) reads and empties @p tau and @p er alone.
 /// Vectorised (Highway).
 void compositeSlabVector(float* tau, float* er, float* eg, float* eb, const TileBuffers& tile, float epsilon,
                          TileRect rect = {});

@@ -90,7 +90,12 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
         slabs.reach = slabReachFor(pending.kernel().radius() * shape.sMax / stream.slabLength());
     }
     const Tables& tables = pending.get();  // read meanwhile (render/pending_tables.h)
-    TileCompositor compositor(camera.width(), camera.height(), tables, exact, slabs, &buffers.compositor);
+    // One colour channel where every primitive's colour is grey: the table's, unshaded, without
+    // emission or the splats' tint (ColorChannels; the same image).
+    const bool grey = settings.greyChannel && table.grey() && !shader && !emission && !settings.showPrimitives;
+    TileCompositor compositor(camera.width(), camera.height(), tables, exact, slabs, &buffers.compositor,
+                              grey ? ColorChannels::Grey : ColorChannels::Rgb);
+    stats.compositedChannels = compositor.channels();
     ProjectionContext ctx{camera,        tables,         volume.voxelSize,  stream.slabLength(),
                           settings.mode, pass.threshold, settings.footprint, settings.showPrimitives,
                           pass.prefilterVariance};

@@ -171,6 +171,7 @@ nlohmann::json RenderStats::toJson() const {
     j["lod_voxels"] = lodVoxels;
     j["splats_exact_index"] = exactIndexSplats;
     j["windows"] = windows;
+    if (compositedChannels > 0) j["composited_channels"] = compositedChannels;
     j["largest_window_voxels"] = largestWindow;
     if (compositedPixels) j["composited_pixels"] = compositedPixels;
     j["page_faults"] = pageFaults;

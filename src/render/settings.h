@@ -157,6 +157,10 @@ struct RenderSettings {
     /// of the image stays empty); false: the whole image, the oracle the crop is tested against
     /// (same image up to float rounding of pixel coordinates; a speed knob, not in the JSON echo).
     bool cropToVolume = true;
+    /// Forward modes: where every colour is grey (a grey transfer function, unshaded, no emission,
+    /// no --show-primitives), the compositor carries one channel (ColorChannels::Grey: the same
+    /// image, bit for bit); false: all three, the oracle it is tested against (a speed knob).
+    bool greyChannel = true;
     StreamOptions stream;                   ///< how the grid is streamed: speed and memory, never the image
     uint64_t maxActiveVoxels = kDefaultMaxActiveVoxels;  ///< larger grids are refused before any work
     ShadingSettings shading;                ///< off by default: the unshaded emission–absorption image
@@ -203,6 +207,7 @@ struct RenderStats {
     uint64_t windows = 0;             ///< forward modes: depth windows streamed
     uint64_t largestWindow = 0;       ///< forward modes: most voxels in one window
     uint64_t compositedPixels = 0;    ///< forward modes: pixels (sub-pixels) the compositor held (the crop)
+    int compositedChannels = 0;       ///< forward modes: colour channels composited (1: grey, RenderSettings::greyChannel; 3)
     /// Minor page faults of the process during the render: the fresh memory it touched, a page (or
     /// a huge page) each. On virtual machines a fault costs microseconds (docs/performance.md,
     /// session 29); a render through kept buffers (RenderControl::buffers) takes few.

@@ -434,6 +434,15 @@ bool ClassificationTable::empty() const {
     return std::none_of(entries_.begin(), entries_.end(), [](const Classified& c) { return c.sigma > 0.f; });
 }
 
+bool ClassificationTable::grey() const {
+    const auto greyColor = [](const glm::vec3& c) { return c.x == c.y && c.x == c.z; };
+    for (int j = 0; j < pieces_.count; ++j)
+        if (!(pieces_.value[0][j] == pieces_.value[1][j] && pieces_.value[0][j] == pieces_.value[2][j] &&
+              pieces_.slope[0][j] == pieces_.slope[1][j] && pieces_.slope[0][j] == pieces_.slope[2][j]))
+            return false;
+    return std::all_of(entries_.begin(), entries_.end(), [&](const Classified& c) { return greyColor(c.color); });
+}
+
 // --- TransferFunction ----------------------------------------------------------
 
 TransferFunction TransferFunction::fromPoints(std::string name, std::vector<ColorPoint> colors,

@@ -108,6 +108,10 @@ public:
     float sigma(float value) const { return (*this)(value).sigma; }
     /// @brief True if no value maps to a positive extinction (nothing to render).
     bool empty() const;
+    /// @brief True if every value classifies to a grey colour (r = g = b, bit for bit): every entry,
+    /// and every piece's values and slopes channel for channel, so each channel takes the same
+    /// float operations on the same numbers (composite/compositing.h, ColorChannels::Grey).
+    bool grey() const;
     /// @brief The continuous table index a raw value maps to (unclamped; for tests).
     float indexOf(float value) const { return value * scale_ + offset_; }
     /// @brief The kSize entries (nullptr when empty) and the index map value·scale + offset:

@@ -111,6 +111,59 @@ void vectorLoopMatchesTheScalarLoop() {
     EXPECT_LT(worst, 2e-6);
 }
 
+// One channel (TileBuffers without G and B, ColorChannels::Grey): the vector loop and the scalar
+// loop leave T and R exactly as with all four channels, for the table and the exact index; the
+// slab compositing likewise, emptying τ and the red sums and leaving the green and blue ones.
+void oneChannelIsTheRedOfThree() {
+    std::mt19937 rng(23);
+    int drawn = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+        SplatRaster s;
+        int tx0 = 0, ty0 = 0;
+        TileArrays a;
+        if (!randomSplat(rng, trial % 2 == 1, s, tx0, ty0, a)) continue;
+        const TileArrays before = a;
+        TileArrays b = a, c = a, d = a;
+        drawSplatVector(s, a.buffers(tx0, ty0));
+        drawSplatVector(s, {b.T.data(), b.R.data(), nullptr, nullptr, tx0, ty0});
+        drawSplatScalarPoly(s, c.buffers(tx0, ty0));
+        drawSplatScalarPoly(s, {d.T.data(), d.R.data(), nullptr, nullptr, tx0, ty0});
+        ASSERT_EQ(a.T, b.T) << "trial " << trial;
+        ASSERT_EQ(a.R, b.R) << "trial " << trial;
+        ASSERT_EQ(c.T, d.T) << "trial " << trial;
+        ASSERT_EQ(c.R, d.R) << "trial " << trial;
+        ASSERT_EQ(b.G, before.G) << "trial " << trial;  // not written
+        ASSERT_EQ(d.B, before.B) << "trial " << trial;
+        drawn += a.R != before.R;
+    }
+    EXPECT_GT(drawn, 50);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    for (int trial = 0; trial < 50; ++trial) {
+        TileArrays a, b;
+        alignas(64) std::array<float, kTilePixels> tau, er, eg, eb;
+        for (size_t i = 0; i < size_t(kTilePixels); ++i) {
+            a.T[i] = u(rng) < 0.1f ? 0.5f * kTransmittanceEpsilon : u(rng), a.R[i] = u(rng), a.G[i] = u(rng), a.B[i] = u(rng);
+            tau[i] = u(rng) < 0.3f ? 0.f : 3.f * u(rng), er[i] = tau[i] * u(rng), eg[i] = 0.5f + u(rng), eb[i] = 0.5f + u(rng);
+        }
+        b = a;
+        alignas(64) std::array<float, kTilePixels> tauB = tau, erB = er, egB = eg, ebB = eb;  // (aligned loads)
+        const auto egBefore = eg;
+        const auto Tbefore = a.T;
+        const TileRect rect{int(8 * u(rng)), int(8 * u(rng)), 16 + int(15 * u(rng)), 16 + int(15 * u(rng))};
+        compositeSlabVector(tau.data(), er.data(), eg.data(), eb.data(), a.buffers(0, 0), kTransmittanceEpsilon, rect);
+        compositeSlabVector(tauB.data(), erB.data(), egB.data(), ebB.data(), {b.T.data(), b.R.data(), nullptr, nullptr, 0, 0},
+                            kTransmittanceEpsilon, rect);
+        ASSERT_EQ(a.T, b.T) << "trial " << trial;
+        ASSERT_EQ(a.R, b.R) << "trial " << trial;
+        ASSERT_EQ(tau, tauB) << "trial " << trial;  // emptied alike
+        ASSERT_EQ(er, erB) << "trial " << trial;
+        ASSERT_EQ(egB, egBefore) << "trial " << trial;  // one channel: the green sums left as they were
+        ASSERT_NE(eg, egBefore) << "trial " << trial;   // three: emptied over the rectangle
+        ASSERT_NE(a.T, Tbefore) << "trial " << trial;   // (the slab was composited)
+    }
+}
+TEST(SplatRaster, OneChannelIsTheRedOfThree) { forEachTarget([] { oneChannelIsTheRedOfThree(); }); }
+
 // The short opacity series (OpacitySeries) a splat takes when every τ it deposits is small give
 // the general form's values to float rounding, at the edges of their ranges (τ up to 0.03 and
 // 0.2): a range too wide for its series (Degree4 up to 0.2: error 1.3e−5) fails here. The bound

@@ -93,5 +93,46 @@ void vectorLoopEqualsTheScalarLoop() {
 // On every SIMD target the CPU has: 16-lane targets draw two rows a vector, the others one.
 TEST(PointRaster, VectorLoopEqualsTheScalarLoop) { test::forEachTarget([] { vectorLoopEqualsTheScalarLoop(); }); }
 
+// One channel (a SlabTile without green and blue sums, ColorChannels::Grey): the vector and the
+// scalar loops write τ and the red sums exactly as with all three, and nothing else.
+void oneChannelIsTheRedOfThree() {
+    std::mt19937 rng(29);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    int drawn = 0;
+    for (int trial = 0; trial < 1000; ++trial) {
+        const int tx0 = kTileSize * int(4 * u(rng)), ty0 = kTileSize * int(4 * u(rng));
+        SlabArrays a;
+        for (size_t i = 0; i < size_t(kTilePixels); ++i) {
+            a.tau[i] = u(rng) < 0.3f ? 0.f : u(rng), a.er[i] = u(rng), a.eg[i] = u(rng), a.eb[i] = u(rng);
+            a.T[i] = u(rng) < 0.2f ? 1e-4f * u(rng) : u(rng);
+        }
+        const float cx = float(tx0) + float(kTileSize) * u(rng), cy = float(ty0) + float(kTileSize) * u(rng);
+        const PointSetup s = setupPoint(PixelCoord(cx, cy), float(pointFilterVariance(2.5 * u(rng), 0.1)));
+        if (s.empty()) continue;
+        PointRaster p;
+        p.cx = cx, p.cy = cy, p.invVariance = s.invVariance, p.radius2 = s.radius2, p.norm = s.norm;
+        p.total = 0.01f + 5.f * u(rng);
+        p.color = glm::vec3(u(rng), u(rng), u(rng));
+        p.x0 = std::max(s.x0, tx0), p.x1 = std::min(s.x0 + s.nx - 1, tx0 + kTileSize - 1);
+        p.y0 = std::max(s.y0, ty0), p.y1 = std::min(s.y0 + s.ny - 1, ty0 + kTileSize - 1);
+        p.epsilon = 1e-4f;
+        const SlabArrays before = a;
+        SlabArrays b = a, c = a, d = a;
+        drawPointVector(p, a.tile(tx0, ty0));
+        drawPointVector(p, {b.tau.data(), b.er.data(), nullptr, nullptr, b.T.data(), tx0, ty0});
+        drawPointScalar(p, c.tile(tx0, ty0));
+        drawPointScalar(p, {d.tau.data(), d.er.data(), nullptr, nullptr, d.T.data(), tx0, ty0});
+        ASSERT_EQ(a.tau, b.tau) << trial;
+        ASSERT_EQ(a.er, b.er) << trial;
+        ASSERT_EQ(c.tau, d.tau) << trial;
+        ASSERT_EQ(c.er, d.er) << trial;
+        ASSERT_EQ(b.eg, before.eg) << trial;
+        ASSERT_EQ(d.eb, before.eb) << trial;
+        drawn += a.tau != before.tau;
+    }
+    EXPECT_GT(drawn, 500);
+}
+TEST(PointRaster, OneChannelIsTheRedOfThree) { test::forEachTarget([] { oneChannelIsTheRedOfThree(); }); }
+
 }  // namespace
 }  // namespace vdbsplat

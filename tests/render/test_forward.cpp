@@ -727,6 +727,52 @@ TEST(Forward, CroppingToTheVolumeKeepsTheImage) {
     }
 }
 
+// One colour channel (ColorChannels::Grey) is a speed knob, never an image knob: with a grey
+// transfer function the image is the three-channel one bit for bit, in every forward mode, far
+// (points and level-of-detail cells), framed and close, and the three-channel image of a grey
+// table is grey (the premise: every channel takes the same operations). The stats say which was
+// composited; a coloured table, shading and the slab order take three.
+TEST(Forward, GreyChannelKeepsTheImage) {
+    const TransferFunction grey = TransferFunction::preset("grey");
+    const Volume& v = checkerBox();
+    int compared = 0;
+    for (const RenderMode mode : kForwardModes)
+        for (const double distance : {6.0, 1.0, 0.4}) {
+            RenderSettings s = settingsFor(mode, distance);
+            RenderStats one, three;
+            const Image a = renderWith(v, grey, s, &one);
+            s.greyChannel = false;
+            const Image b = renderWith(v, grey, s, &three);
+            ASSERT_EQ(one.compositedChannels, 1) << toString(mode) << " " << distance;
+            ASSERT_EQ(three.compositedChannels, 3) << toString(mode) << " " << distance;
+            ASSERT_EQ(a.pixels, b.pixels) << toString(mode) << " " << distance;
+            double sum = 0.0;
+            for (const glm::vec4& px : b.pixels) {
+                ASSERT_EQ(px.x, px.y);
+                ASSERT_EQ(px.x, px.z);
+                sum += px.w;
+            }
+            EXPECT_GT(sum, 1.0) << toString(mode) << " " << distance;  // the volume is in the picture
+            compared += one.points + one.splats > 0;
+        }
+    EXPECT_EQ(compared, 18);
+    RenderStats stats;
+    renderWith(v, TransferFunction::preset("fire"), settingsFor(RenderMode::Hybrid, 1.0), &stats);
+    EXPECT_EQ(stats.compositedChannels, 3);
+    RenderSettings slabs = settingsFor(RenderMode::Hybrid, 1.0);
+    slabs.compositing = CompositingOrder::Slabs;
+    renderWith(v, grey, slabs, &stats);
+    EXPECT_EQ(stats.compositedChannels, 3);
+    RenderSettings shaded = settingsFor(RenderMode::Hybrid, 1.0);
+    shaded.shading.mode = ShadingMode::Phong;
+    renderWith(v, grey, shaded, &stats);
+    EXPECT_EQ(stats.compositedChannels, 3);
+    RenderSettings tinted = settingsFor(RenderMode::Hybrid, 1.0);
+    tinted.showPrimitives = true;
+    renderWith(v, grey, tinted, &stats);
+    EXPECT_EQ(stats.compositedChannels, 3);
+}
+
 // The window size is a memory knob, never an image knob: narrowing the windows to a few
 // thousand voxels (a slab or two each) gives the same image, bit for bit, in every mode.
 TEST(Forward, ImagesDoNotDependOnTheWindowSize) {

@@ -242,6 +242,30 @@ TEST(TransferFunctionBake, ManyPointsClassifyThroughTheTable) {
                   .find("linear pieces"), std::string::npos);
 }
 
+// grey() (the compositor's one channel, composite/compositing.h): every value's colour grey, bit
+// for bit, through the pieces and through the entries; one colour point off grey, anywhere, is not.
+TEST(TransferFunctionBake, GreyTablesAreRecognised) {
+    EXPECT_TRUE(TransferFunction::preset("grey").bake(0.f, 1.f, 1.0).grey());
+    EXPECT_FALSE(TransferFunction::preset("ct-bone").bake(0.f, 1.f, 1.0).grey());
+    EXPECT_FALSE(TransferFunction::preset("fire").bake(0.f, 1.f, 1.0).grey());
+    std::vector<TransferFunction::ExtinctionPoint> saw;  // more than 16 pieces: classified through the entries
+    for (int k = 0; k <= 20; ++k) saw.push_back({float(k) / 20.f, float(k % 2)});
+    std::vector<TransferFunction::ColorPoint> greys = {{0.f, glm::vec3(0.1f)}, {0.3f, glm::vec3(0.7f)}, {1.f, glm::vec3(0.2f)}};
+    const ClassificationTable entries = TransferFunction::fromPoints("g", greys, saw).bake(-2.f, 5.f, 1.0);
+    ASSERT_EQ(entries.pieces().count, 0);
+    EXPECT_TRUE(entries.grey());
+    const ClassificationTable pieces = TransferFunction::fromPoints("g", greys, {{0.f, 0.f}, {1.f, 1.f}}).bake(-2.f, 5.f, 1.0);
+    ASSERT_GT(pieces.pieces().count, 0);
+    EXPECT_TRUE(pieces.grey());
+    for (const bool manyPieces : {false, true}) {
+        auto tinted = greys;
+        tinted[1].rgb.z = std::nextafter(0.7f, 1.f);  // one ulp of blue at one point
+        const auto sigma = manyPieces ? saw : std::vector<TransferFunction::ExtinctionPoint>{{0.f, 0.f}, {1.f, 1.f}};
+        EXPECT_FALSE(TransferFunction::fromPoints("t", tinted, sigma).bake(-2.f, 5.f, 1.0).grey()) << manyPieces;
+    }
+    EXPECT_TRUE(ClassificationTable().grey());  // empty: nothing is drawn
+}
+
 TEST(TransferFunctionBake, BothEndsOfTheRangeMapExactly) {
     const float lo = -3.f, hi = 7.f;
     const TransferFunction tf = TransferFunction::preset("ct-bone");
