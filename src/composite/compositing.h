@@ -15,10 +15,10 @@ namespace vdbsplat {
 enum class CompositingOrder { Kernels, Slabs };
 
 /// @brief The colour channels the compositor's vector loops carry. Grey: every primitive's colour
-/// is grey (c.x = c.y = c.z: a grey transfer function, unshaded, no emission), so compositing
-/// green and blue would repeat red's operations on red's values; the loops composite T and R
-/// alone and the frame's G and B are R. The image is the Rgb one bit for bit, for half the
-/// loads and stores of each deposit. The compositor takes it only in the kernel order.
+/// is grey (c.x = c.y = c.z: a grey transfer function, shaded by white light or not, no emission),
+/// so compositing green and blue would repeat red's operations on red's values; the loops
+/// composite T and R (or deposit τ and the red sums, in the slab order) alone and the frame's G
+/// and B are R. The image is the Rgb one bit for bit, for half the loads and stores of each deposit.
 enum class ColorChannels { Rgb, Grey };
 
 /// @brief What the projection and the compositor share in the Slabs order.

@@ -110,7 +110,8 @@ struct TileCompositor::SlabRing {
     }
     /// The slabs a primitive of slab @p slab with @p profile deposits into (those of non-zero
     /// fraction), marked dirty and open.
-    SlabTargets targets(const SlabProfile& profile, int64_t slab, int reach) {
+    /// @p grey: without the green and blue sums (ColorChannels::Grey).
+    SlabTargets targets(const SlabProfile& profile, int64_t slab, int reach, bool grey) {
         SlabTargets t;
         for (int j = 0; j <= 2 * reach; ++j) {
             const float f = profile.fraction[size_t(j)];
@@ -121,7 +122,8 @@ struct TileCompositor::SlabRing {
             b.dirty = true;
             last = open() ? std::max(last, to) : to;
             const size_t n = size_t(t.count++);
-            t.tau[n] = b.tau.data(), t.er[n] = b.er.data(), t.eg[n] = b.eg.data(), t.eb[n] = b.eb.data();
+            t.tau[n] = b.tau.data(), t.er[n] = b.er.data();
+            t.eg[n] = grey ? nullptr : b.eg.data(), t.eb[n] = grey ? nullptr : b.eb.data();
             t.fraction[n] = f;
         }
         return t;
@@ -132,7 +134,7 @@ TileCompositor::TileCompositor(int width, int height, const Tables& tables, cons
                                CompositorBuffers* buffers, ColorChannels channels)
     : width_(width), height_(height), tilesX_((width + kTileSize - 1) / kTileSize),
       tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact), slabs_(slabs),
-      grey_(channels == ColorChannels::Grey && exact.vector && !slabs.on),
+      grey_(channels == ColorChannels::Grey && exact.vector),
       own_(buffers ? nullptr : std::make_unique<CompositorBuffers>()), kept_(buffers ? *buffers : *own_),
       color_(kept_.color), transmittance_(kept_.transmittance), liveCount_(size_t(tilesX_) * tilesY_),
       binStart_(kept_.binStart), binEntries_(kept_.binEntries), binScratch_(kept_.binScratch), binCounts_(kept_.binCounts) {
@@ -504,7 +506,7 @@ void TileCompositor::compositeTileSlabs(int tile, std::span<const Entry> entries
         // Tile-level early termination, checked every 32 primitives (open slabs of finished
         // pixels add at most ε·c; they are composited below all the same).
         if ((e & 31) == 31 && !px.anyLive()) break;
-        const SlabTargets targets = ring.targets(window_->profile[i], slab, reach);
+        const SlabTargets targets = ring.targets(window_->profile[i], slab, reach, grey_);
         if (targets.count > 0) drawPrimitive(p, i, px, nullptr, &targets);
     }
     closeUpTo(closeBefore);
@@ -580,6 +582,7 @@ void depositAt(Pixels& px, int i, float tau, const glm::vec3& color, const SlabT
         const float t = tau * slabs->fraction[size_t(j)];
         slabs->tau[size_t(j)][i] += t;
         slabs->er[size_t(j)][i] += t * color.x;
+        if (!slabs->eg[size_t(j)]) continue;  // one channel (ColorChannels::Grey)
         slabs->eg[size_t(j)][i] += t * color.y;
         slabs->eb[size_t(j)][i] += t * color.z;
     }

@@ -80,7 +80,7 @@ class TileCompositor {
 public:
     /// @param buffers where the large buffers live (kept by the caller across renders); null: its own.
     /// @param channels Grey: every primitive's colour is grey (ColorChannels); taken with the vector
-    /// loops in the kernel order, else the compositor carries all three.
+    /// loops, else (the scalar oracle) the compositor carries all three.
     TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs = {},
                    CompositorBuffers* buffers = nullptr, ColorChannels channels = ColorChannels::Rgb);
     ~TileCompositor();

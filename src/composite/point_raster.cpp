@@ -23,8 +23,8 @@ constexpr int kStride = kTileSize;  // tile row stride
 
 /// kSlabs false: the kernel order, into one slab's sums (@p tile); true: into @p slabs by their
 /// fractions. A template argument, so the kernel order's loop is the code it was before the slab
-/// order (through a one-slab SlabTargets it cost the far views' point loop 20 %). kGrey (the kernel
-/// order only): @p tile has no green and blue sums, only τ and the red one are written.
+/// order (through a one-slab SlabTargets it cost the far views' point loop 20 %). kGrey: @p tile or
+/// @p slabs have no green and blue sums (ColorChannels::Grey), only τ and the red ones are written.
 template <bool kSlabs, bool kGrey, class D>
 void DrawPointFor(D d, const PointRaster& p, const SlabTargets* slabs, const SlabTile* tile, const float* T, int tileX0,
                   int tileY0) {
@@ -164,6 +164,7 @@ void DrawPoint(const PointRaster& p, const SlabTile& tile) {
 
 void DrawPointSlabs(const PointRaster& p, const SlabTargets& slabs, const float* T, int x0, int y0) {
     if (p.x0 > p.x1 || p.y0 > p.y1) return;
+    if (!slabs.eg[0]) return DrawPointIn<true, true>(p, &slabs, nullptr, T, x0, y0);
     DrawPointIn<true>(p, &slabs, nullptr, T, x0, y0);
 }
 

@@ -25,9 +25,12 @@ constexpr int kPairLanes = 16;  // DrawRowPairs: two rows of 8 pixels per vector
 
 /// Where a splat's deposits go, a template argument of every loop (so each is the code it would be
 /// alone: a branch per vector, with the other deposits inlined beside it, cost the kernel order 15 %
-/// when the slab order came): "over" the tile's four channels, "over" its T and R alone (TileBuffers
-/// without G and B: every colour grey, so G and B would be R), or the slab sums (--compositing slabs).
-enum class Sink { Over, OverGrey, Slabs };
+/// when the slab order came): "over" the tile's four channels, or the slab sums (--compositing
+/// slabs); each also with one channel (TileBuffers without G and B, SlabTargets without green and
+/// blue sums: every colour grey, ColorChannels::Grey), T and R or τ and the red sums alone.
+enum class Sink { Over, OverGrey, Slabs, SlabsGrey };
+constexpr bool IsSlabs(Sink k) { return k == Sink::Slabs || k == Sink::SlabsGrey; }
+constexpr bool IsGrey(Sink k) { return k == Sink::OverGrey || k == Sink::SlabsGrey; }
 
 /// The exact d² = 1 − (1 − i²)/w from the affine index i² and the map's w at the same pixel
 /// (ExactIndexMap::d2), clamped at 0.
@@ -103,7 +106,7 @@ HWY_INLINE V OpacityFromTau(D d, V tau, OpacitySeries series = OpacitySeries::An
 
 /// --compositing slabs: τ·fraction_j and τ·fraction_j·c added to slab j's sums at the lanes of
 /// @p mask; @p load and @p store read and write one vector of a tile array at the lanes' pixels.
-template <class D, class V, class M, class Load, class Store>
+template <bool kGrey, class D, class V, class M, class Load, class Store>
 HWY_INLINE void DepositSlabs(D d, const SplatRaster& s, V tau, M mask, const Load& load, const Store& store) {
     const V cr = hn::Set(d, s.color.x), cg = hn::Set(d, s.color.y), cb = hn::Set(d, s.color.z);
     const SlabTargets& slabs = *s.slabs;
@@ -111,9 +114,11 @@ HWY_INLINE void DepositSlabs(D d, const SplatRaster& s, V tau, M mask, const Loa
     const V tauIn = hn::IfThenElseZero(mask, tau);
     for (int j = 0; j < slabs.count; ++j) {
         const V tj = hn::Mul(tauIn, hn::Set(d, slabs.fraction[size_t(j)]));
-        float *pt = slabs.tau[size_t(j)], *pr = slabs.er[size_t(j)], *pg = slabs.eg[size_t(j)], *pb = slabs.eb[size_t(j)];
+        float *pt = slabs.tau[size_t(j)], *pr = slabs.er[size_t(j)];
         store(pt, hn::Add(load(pt), tj));
         store(pr, hn::MulAdd(tj, cr, load(pr)));
+        if constexpr (kGrey) continue;
+        float *pg = slabs.eg[size_t(j)], *pb = slabs.eb[size_t(j)];
         store(pg, hn::MulAdd(tj, cg, load(pg)));
         store(pb, hn::MulAdd(tj, cb, load(pb)));
     }
@@ -128,8 +133,8 @@ HWY_INLINE void DepositSlabs(D d, const SplatRaster& s, V tau, M mask, const Loa
 template <Sink kSink, class D, class V, class M, class Load, class Store>
 HWY_INLINE void Deposit(D d, const SplatRaster& s, const TileBuffers& tile, V tau, V T, M mask, const V (&rgb)[3],
                         const Load& load, const Store& store) {
-    if constexpr (kSink == Sink::Slabs) {
-        DepositSlabs(d, s, tau, mask, load, store);
+    if constexpr (IsSlabs(kSink)) {
+        DepositSlabs<IsGrey(kSink)>(d, s, tau, mask, load, store);
     } else {
         const V ta = hn::Mul(T, OpacityFromTau(d, tau, s.series));  // T·α
         const V R = load(tile.R);
@@ -413,7 +418,7 @@ void DrawSplatRowsFor(D d, const SplatRaster& s, const TileBuffers& tile) {
 
 void DrawSplatRows(const SplatRaster& s, const TileBuffers& tile) {
     const hn::CappedTag<float, kPairLanes> d;
-    if (s.slabs) return DrawSplatRowsFor<Sink::Slabs>(d, s, tile);
+    if (s.slabs) return s.slabs->eg[0] ? DrawSplatRowsFor<Sink::Slabs>(d, s, tile) : DrawSplatRowsFor<Sink::SlabsGrey>(d, s, tile);
     if (!tile.G) return DrawSplatRowsFor<Sink::OverGrey>(d, s, tile);
     DrawSplatRowsFor<Sink::Over>(d, s, tile);
 }
@@ -486,6 +491,7 @@ void drawSplatScalarPoly(const SplatRaster& s, const TileBuffers& tile) {
                     const float tj = tau * s.slabs->fraction[size_t(j)];
                     s.slabs->tau[size_t(j)][i] += tj;
                     s.slabs->er[size_t(j)][i] += tj * s.color.x;
+                    if (!s.slabs->eg[size_t(j)]) continue;  // one channel
                     s.slabs->eg[size_t(j)][i] += tj * s.color.y;
                     s.slabs->eb[size_t(j)][i] += tj * s.color.z;
                 }

@@ -90,9 +90,10 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
         slabs.reach = slabReachFor(pending.kernel().radius() * shape.sMax / stream.slabLength());
     }
     const Tables& tables = pending.get();  // read meanwhile (render/pending_tables.h)
-    // One colour channel where every primitive's colour is grey: the table's, unshaded, without
-    // emission or the splats' tint (ColorChannels; the same image).
-    const bool grey = settings.greyChannel && table.grey() && !shader && !emission && !settings.showPrimitives;
+    // One colour channel where every primitive's colour is grey: the table's, shaded or not (white
+    // light: c·D + S, the same operations on each channel), without emission or the splats' tint
+    // (ColorChannels; the same image).
+    const bool grey = settings.greyChannel && table.grey() && !emission && !settings.showPrimitives;
     TileCompositor compositor(camera.width(), camera.height(), tables, exact, slabs, &buffers.compositor,
                               grey ? ColorChannels::Grey : ColorChannels::Rgb);
     stats.compositedChannels = compositor.channels();

@@ -157,9 +157,9 @@ struct RenderSettings {
     /// of the image stays empty); false: the whole image, the oracle the crop is tested against
     /// (same image up to float rounding of pixel coordinates; a speed knob, not in the JSON echo).
     bool cropToVolume = true;
-    /// Forward modes: where every colour is grey (a grey transfer function, unshaded, no emission,
-    /// no --show-primitives), the compositor carries one channel (ColorChannels::Grey: the same
-    /// image, bit for bit); false: all three, the oracle it is tested against (a speed knob).
+    /// Forward modes: where every colour is grey (a grey transfer function, shaded or not, no
+    /// emission, no --show-primitives), the compositor carries one channel (ColorChannels::Grey:
+    /// the same image, bit for bit); false: all three, the oracle it is tested against (a speed knob).
     bool greyChannel = true;
     StreamOptions stream;                   ///< how the grid is streamed: speed and memory, never the image
     uint64_t maxActiveVoxels = kDefaultMaxActiveVoxels;  ///< larger grids are refused before any work

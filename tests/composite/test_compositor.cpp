@@ -135,6 +135,29 @@ void oneChannelIsTheRedOfThree() {
         ASSERT_EQ(b.G, before.G) << "trial " << trial;  // not written
         ASSERT_EQ(d.B, before.B) << "trial " << trial;
         drawn += a.R != before.R;
+        // The slab order: two slabs taking fractions of each τ, with and without green and blue sums.
+        TileArrays sa[2], sb[2];
+        SlabTargets ta, tb;
+        ta.count = tb.count = 2;
+        for (size_t j = 0; j < 2; ++j) {
+            sa[j] = before, sb[j] = before;
+            ta.tau[j] = sa[j].T.data(), ta.er[j] = sa[j].R.data(), ta.eg[j] = sa[j].G.data(), ta.eb[j] = sa[j].B.data();
+            tb.tau[j] = sb[j].T.data(), tb.er[j] = sb[j].R.data();
+            ta.fraction[j] = tb.fraction[j] = 0.3f + 0.4f * float(j);
+        }
+        for (const bool vector : {true, false}) {
+            s.slabs = &ta;
+            vector ? drawSplatVector(s, a.buffers(tx0, ty0)) : drawSplatScalarPoly(s, a.buffers(tx0, ty0));
+            s.slabs = &tb;
+            vector ? drawSplatVector(s, {a.T.data(), a.R.data(), nullptr, nullptr, tx0, ty0})
+                   : drawSplatScalarPoly(s, {a.T.data(), a.R.data(), nullptr, nullptr, tx0, ty0});
+            for (size_t j = 0; j < 2; ++j) {
+                ASSERT_EQ(sa[j].T, sb[j].T) << "trial " << trial << " slab " << j;  // τ sums
+                ASSERT_EQ(sa[j].R, sb[j].R) << "trial " << trial << " slab " << j;  // red sums
+                ASSERT_EQ(sb[j].G, before.G) << "trial " << trial << " slab " << j;
+            }
+        }
+        s.slabs = nullptr;
     }
     EXPECT_GT(drawn, 50);
     std::uniform_real_distribution<float> u(0.f, 1.f);

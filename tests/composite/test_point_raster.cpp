@@ -129,6 +129,24 @@ void oneChannelIsTheRedOfThree() {
         ASSERT_EQ(b.eg, before.eg) << trial;
         ASSERT_EQ(d.eb, before.eb) << trial;
         drawn += a.tau != before.tau;
+        // The slab order: two slabs, with and without green and blue sums, vector and scalar.
+        for (const bool vector : {true, false}) {
+            SlabArrays sa[2] = {before, before}, sb[2] = {before, before};
+            SlabTargets ta, tb;
+            ta.count = tb.count = 2;
+            for (size_t j = 0; j < 2; ++j) {
+                ta.tau[j] = sa[j].tau.data(), ta.er[j] = sa[j].er.data(), ta.eg[j] = sa[j].eg.data(), ta.eb[j] = sa[j].eb.data();
+                tb.tau[j] = sb[j].tau.data(), tb.er[j] = sb[j].er.data();
+                ta.fraction[j] = tb.fraction[j] = 0.3f + 0.4f * float(j);
+            }
+            (vector ? drawPointSlabsVector : drawPointSlabsScalar)(p, ta, before.T.data(), tx0, ty0);
+            (vector ? drawPointSlabsVector : drawPointSlabsScalar)(p, tb, before.T.data(), tx0, ty0);
+            for (size_t j = 0; j < 2; ++j) {
+                ASSERT_EQ(sa[j].tau, sb[j].tau) << trial;
+                ASSERT_EQ(sa[j].er, sb[j].er) << trial;
+                ASSERT_EQ(sb[j].eg, before.eg) << trial;
+            }
+        }
     }
     EXPECT_GT(drawn, 500);
 }
