@@ -68,6 +68,10 @@ VoxelShader::VoxelShader(const Volume& volume, const ClassificationTable& table,
 openvdb::Vec3f VoxelShader::operator()(Accessor& acc, const FloatLeaf* leaf, openvdb::Index n,
                                        const openvdb::Coord& ijk, float value) const {
     if (!(table_.sigma(value) > 0.f)) return {1.f, 0.f, 1.f};  // drawn by nobody: leave it unshaded
+    return shadeDrawn(acc, leaf, n, ijk);
+}
+
+openvdb::Vec3f VoxelShader::shadeDrawn(Accessor& acc, const FloatLeaf* leaf, openvdb::Index n, const openvdb::Coord& ijk) const {
     float raw[6];
     neighbourValues(leaf, n, ijk, acc, background_, raw);
     const glm::vec3 g = gradientOf(raw, lo_, hi_);

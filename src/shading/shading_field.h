@@ -40,6 +40,9 @@ public:
     /// neighbour is then read through @p acc). The result does not depend on which path reads.
     openvdb::Vec3f operator()(Accessor& acc, const FloatLeaf* leaf, openvdb::Index n,
                               const openvdb::Coord& ijk, float value) const;
+    /// @brief The same for a voxel the caller has classified to σ > 0 (the stream's classifier):
+    /// operator() without classifying it again (which was 7 % of a shaded far view).
+    openvdb::Vec3f shadeDrawn(Accessor& acc, const FloatLeaf* leaf, openvdb::Index n, const openvdb::Coord& ijk) const;
 
     const Volume& volume() const { return volume_; }
 

@@ -297,7 +297,7 @@ public:
     Classified operator()(const openvdb::FloatTree::LeafNodeType* leaf, openvdb::Index n, const openvdb::Coord& ijk,
                           float value) {
         Classified cls = table_(value);
-        if (shader_ && cls.sigma > 0.f) cls = applyShading(cls, (*shader_)(*shaderAcc_, leaf, n, ijk, value));
+        if (shader_ && cls.sigma > 0.f) cls = applyShading(cls, shader_->shadeDrawn(*shaderAcc_, leaf, n, ijk));
         return emission_ ? applyEmission(cls, emission_->at(*emissionAcc_, ijk)) : cls;
     }
 
