@@ -18,6 +18,32 @@ struct SlabArrays {
     SlabTile tile(int x0, int y0) { return {tau.data(), er.data(), eg.data(), eb.data(), T.data(), x0, y0}; }
 };
 
+/// Random slab sums and transmittance over one tile, some pixels finished (T < @p epsilon).
+void randomTile(std::mt19937& rng, SlabArrays& a, float epsilon) {
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    for (size_t i = 0; i < size_t(kTilePixels); ++i) {
+        a.tau[i] = u(rng) < 0.3f ? 0.f : u(rng), a.er[i] = u(rng), a.eg[i] = u(rng), a.eb[i] = u(rng);
+        a.T[i] = u(rng) < 0.2f ? epsilon * u(rng) : u(rng);
+    }
+}
+
+/// The point at (@p cx, @p cy) of filter variance @p v set up as the compositor does (PointSetup)
+/// and clipped to the tile at (@p tx0, @p ty0), with a random total and colour; false when its
+/// filter is empty.
+bool pointInTile(std::mt19937& rng, float cx, float cy, float v, int tx0, int ty0, float epsilon, PointRaster& p) {
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    const PointSetup s = setupPoint(PixelCoord(cx, cy), v);
+    if (s.empty()) return false;
+    p = PointRaster{};
+    p.cx = cx, p.cy = cy, p.invVariance = s.invVariance, p.radius2 = s.radius2, p.norm = s.norm;
+    p.total = 0.01f + 5.f * u(rng);
+    p.color = glm::vec3(u(rng), u(rng), u(rng));
+    p.x0 = std::max(s.x0, tx0), p.x1 = std::min(s.x0 + s.nx - 1, tx0 + kTileSize - 1);
+    p.y0 = std::max(s.y0, ty0), p.y1 = std::min(s.y0 + s.ny - 1, ty0 + kTileSize - 1);
+    p.epsilon = epsilon;
+    return true;
+}
+
 void vectorLoopEqualsTheScalarLoop() {
     std::mt19937 rng(13);
     std::uniform_real_distribution<float> u(0.f, 1.f);
@@ -26,23 +52,13 @@ void vectorLoopEqualsTheScalarLoop() {
     for (int trial = 0; trial < 4000; ++trial) {
         const int tx0 = kTileSize * int(4 * u(rng)), ty0 = kTileSize * int(4 * u(rng));  // the tile's first pixel
         SlabArrays a, b;
-        for (size_t i = 0; i < size_t(kTilePixels); ++i) {
-            a.tau[i] = u(rng) < 0.3f ? 0.f : u(rng), a.er[i] = u(rng), a.eg[i] = u(rng), a.eb[i] = u(rng);
-            a.T[i] = u(rng) < 0.2f ? kEpsilon * u(rng) : u(rng);  // some pixels finished
-        }
+        randomTile(rng, a, kEpsilon);
         b = a;
         // A centre in or near the tile; variances of both low-passes and of --mode none.
         const float cx = float(tx0) - 4.f + float(kTileSize + 8) * u(rng), cy = float(ty0) - 4.f + float(kTileSize + 8) * u(rng);
         const float v = trial % 7 == 0 ? 1.f / 36.f : float(pointFilterVariance(2.5 * u(rng), trial % 2 ? 0.1 : 1.0));
-        const PointSetup s = setupPoint(PixelCoord(cx, cy), v);
-        if (s.empty()) continue;
         PointRaster p;
-        p.cx = cx, p.cy = cy, p.invVariance = s.invVariance, p.radius2 = s.radius2, p.norm = s.norm;
-        p.total = 0.01f + 5.f * u(rng);
-        p.color = glm::vec3(u(rng), u(rng), u(rng));
-        p.x0 = std::max(s.x0, tx0), p.x1 = std::min(s.x0 + s.nx - 1, tx0 + kTileSize - 1);
-        p.y0 = std::max(s.y0, ty0), p.y1 = std::min(s.y0 + s.ny - 1, ty0 + kTileSize - 1);
-        p.epsilon = kEpsilon;
+        if (!pointInTile(rng, cx, cy, v, tx0, ty0, kEpsilon, p)) continue;
         const SlabArrays before = a;
         drawPointScalar(p, a.tile(tx0, ty0));
         drawPointVector(p, b.tile(tx0, ty0));
@@ -102,20 +118,10 @@ void oneChannelIsTheRedOfThree() {
     for (int trial = 0; trial < 1000; ++trial) {
         const int tx0 = kTileSize * int(4 * u(rng)), ty0 = kTileSize * int(4 * u(rng));
         SlabArrays a;
-        for (size_t i = 0; i < size_t(kTilePixels); ++i) {
-            a.tau[i] = u(rng) < 0.3f ? 0.f : u(rng), a.er[i] = u(rng), a.eg[i] = u(rng), a.eb[i] = u(rng);
-            a.T[i] = u(rng) < 0.2f ? 1e-4f * u(rng) : u(rng);
-        }
+        randomTile(rng, a, 1e-4f);
         const float cx = float(tx0) + float(kTileSize) * u(rng), cy = float(ty0) + float(kTileSize) * u(rng);
-        const PointSetup s = setupPoint(PixelCoord(cx, cy), float(pointFilterVariance(2.5 * u(rng), 0.1)));
-        if (s.empty()) continue;
         PointRaster p;
-        p.cx = cx, p.cy = cy, p.invVariance = s.invVariance, p.radius2 = s.radius2, p.norm = s.norm;
-        p.total = 0.01f + 5.f * u(rng);
-        p.color = glm::vec3(u(rng), u(rng), u(rng));
-        p.x0 = std::max(s.x0, tx0), p.x1 = std::min(s.x0 + s.nx - 1, tx0 + kTileSize - 1);
-        p.y0 = std::max(s.y0, ty0), p.y1 = std::min(s.y0 + s.ny - 1, ty0 + kTileSize - 1);
-        p.epsilon = 1e-4f;
+        if (!pointInTile(rng, cx, cy, float(pointFilterVariance(2.5 * u(rng), 0.1)), tx0, ty0, 1e-4f, p)) continue;
         const SlabArrays before = a;
         SlabArrays b = a, c = a, d = a;
         drawPointVector(p, a.tile(tx0, ty0));
