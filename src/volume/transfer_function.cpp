@@ -396,6 +396,18 @@ TransferFunction firePreset() {
 
 // --- ClassificationTable -----------------------------------------------------
 
+namespace {
+/// Every entry's colour, and every piece's values and slopes, the same in r, g and b (bit for bit).
+bool everyColorGrey(const std::vector<Classified>& entries, const LinearPieces& pieces) {
+    for (int j = 0; j < pieces.count; ++j)
+        if (!(pieces.value[0][j] == pieces.value[1][j] && pieces.value[0][j] == pieces.value[2][j] &&
+              pieces.slope[0][j] == pieces.slope[1][j] && pieces.slope[0][j] == pieces.slope[2][j]))
+            return false;
+    return std::all_of(entries.begin(), entries.end(),
+                       [](const Classified& c) { return c.color.x == c.color.y && c.color.x == c.color.z; });
+}
+}  // namespace
+
 ClassificationTable::ClassificationTable(std::vector<Classified> entries, float valueMin, float valueMax,
                                          const LinearPieces& pieces)
     : entries_(std::move(entries)), pieces_(pieces) {
@@ -415,6 +427,7 @@ ClassificationTable::ClassificationTable(std::vector<Classified> entries, float 
         throw Error("classification table: linear pieces must number 0.." + std::to_string(LinearPieces::kMax) +
                     ", start at index 0 with knots not decreasing below " + std::to_string(kSize - 1) +
                     ", and hold finite values and slopes");
+    grey_ = everyColorGrey(entries_, pieces_);
     if (pieces_.count) {
         static_assert(LinearPieces::kMax * LinearPieces::kBucketWidth == kSize, "the buckets cover the table");
         pieces_.index();
@@ -432,15 +445,6 @@ bool ClassificationTable::empty() const {
     if (entries_.empty()) return true;
     if (pieces_.count) return pieces_.firstOpaque() == pieces_.count;
     return std::none_of(entries_.begin(), entries_.end(), [](const Classified& c) { return c.sigma > 0.f; });
-}
-
-bool ClassificationTable::grey() const {
-    const auto greyColor = [](const glm::vec3& c) { return c.x == c.y && c.x == c.z; };
-    for (int j = 0; j < pieces_.count; ++j)
-        if (!(pieces_.value[0][j] == pieces_.value[1][j] && pieces_.value[0][j] == pieces_.value[2][j] &&
-              pieces_.slope[0][j] == pieces_.slope[1][j] && pieces_.slope[0][j] == pieces_.slope[2][j]))
-            return false;
-    return std::all_of(entries_.begin(), entries_.end(), [&](const Classified& c) { return greyColor(c.color); });
 }
 
 // --- TransferFunction ----------------------------------------------------------

@@ -110,8 +110,9 @@ public:
     bool empty() const;
     /// @brief True if every value classifies to a grey colour (r = g = b, bit for bit): every entry,
     /// and every piece's values and slopes channel for channel, so each channel takes the same
-    /// float operations on the same numbers (composite/compositing.h, ColorChannels::Grey).
-    bool grey() const;
+    /// float operations on the same numbers (composite/compositing.h, ColorChannels::Grey). Found
+    /// once, when the table is made (every render asks).
+    bool grey() const { return grey_; }
     /// @brief The continuous table index a raw value maps to (unclamped; for tests).
     float indexOf(float value) const { return value * scale_ + offset_; }
     /// @brief The kSize entries (nullptr when empty) and the index map value·scale + offset:
@@ -134,6 +135,7 @@ private:
     float scale_ = float(kSize - 1);  ///< index = value · scale_ + offset_
     float offset_ = 0.f;
     float transparentBelow_ = -1.f;  ///< see transparentBelow()
+    bool grey_ = true;               ///< see grey(); an empty table draws nothing
 };
 
 /// @brief A piecewise-linear transfer function over the normalised value x ∈ [0, 1].
