@@ -85,6 +85,50 @@ openvdb::Vec3f VoxelShader::shadeDrawn(Accessor& acc, const FloatLeaf* leaf, ope
     return {f.diffuse, f.specular, gradientOpacityFactor(magnitude, settings_.gradientOpacity)};
 }
 
+bool VoxelShader::shadeLeaf(Accessor& acc, const FloatLeaf& leaf, LeafFactors& out) const {
+    if (!leafShadingSupported()) return false;
+    LeafShadingInput in;
+    const float scale = 1.f / (hi_ - lo_);  // as gradientOf normalises
+    constexpr int kS = LeafShadingInput::kSide, kDim = int(FloatLeaf::DIM);
+    const auto at = [&](int x, int y, int z) -> float& { return in.padded[((x + 1) * kS + (y + 1)) * kS + z + 1]; };
+    // The leaf's own values (an inactive one reads as the background), normalised.
+    const float* values = leaf.buffer().data();
+    for (openvdb::Index n = 0; n < FloatLeaf::SIZE; ++n)
+        at(int(n >> 6), int((n >> 3) & 7), int(n & 7)) = normalised(leaf.isValueOn(n) ? values[n] : background_, lo_, scale);
+    // Each face neighbour's layer: from its leaf, or, where there is none, the tile or background
+    // value that covers the whole 8³ region beside the leaf (what probeValue reads at each voxel).
+    const openvdb::Coord origin = leaf.origin();
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = -1; side <= 1; side += 2) {
+            openvdb::Coord q = origin;
+            q[axis] += side * kDim;
+            const int layer = side < 0 ? -1 : kDim, inNeighbour = side < 0 ? kDim - 1 : 0;
+            const FloatLeaf* beside = acc.probeConstLeaf(q);
+            float tile = background_;
+            if (!beside && !acc.probeValue(q, tile)) tile = background_;
+            for (int u = 0; u < kDim; ++u)
+                for (int v = 0; v < kDim; ++v) {
+                    int c[3];  // (layer, u, v) arranged along (axis, the other two)
+                    c[axis] = inNeighbour, c[(axis + 1) % 3] = u, c[(axis + 2) % 3] = v;
+                    float raw = tile;
+                    if (beside) {
+                        const openvdb::Index m = FloatLeaf::coordToOffset(openvdb::Coord(c[0], c[1], c[2]));
+                        raw = beside->isValueOn(m) ? beside->getValue(m) : background_;
+                    }
+                    c[axis] = layer;
+                    at(c[0], c[1], c[2]) = normalised(raw, lo_, scale);
+                }
+        }
+    in.origin = glm::ivec3(origin.x(), origin.y(), origin.z());
+    in.indexToWorld = volume_.indexToWorld;
+    in.eye = eye_;
+    in.gradientToWorld = gradientToWorld_;
+    in.toLight = toLight_;
+    in.settings = settings_;
+    shadeLeafRows(in, out);
+    return true;
+}
+
 ShadingField::ShadingField(const VoxelShader& shader) {
     const auto start = std::chrono::steady_clock::now();
     const openvdb::FloatTree& values = *shader.volume().tree;

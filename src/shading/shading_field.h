@@ -15,6 +15,7 @@
 
 #include <glm/glm.hpp>
 
+#include "shading/shade_leaf.h"
 #include "shading/shading.h"
 #include "volume/grid.h"
 #include "volume/transfer_function.h"
@@ -43,6 +44,10 @@ public:
     /// @brief The same for a voxel the caller has classified to σ > 0 (the stream's classifier):
     /// operator() without classifying it again (which was 7 % of a shaded far view).
     openvdb::Vec3f shadeDrawn(Accessor& acc, const FloatLeaf* leaf, openvdb::Index n, const openvdb::Coord& ijk) const;
+    /// @brief Every voxel's factors of @p leaf at once, vectorised (shading/shade_leaf.h): for
+    /// each voxel n the (D, S, G) shadeDrawn gives, bit for bit (active or not: read those drawn).
+    /// @return false, writing nothing, where leafShadingSupported() does not hold.
+    bool shadeLeaf(Accessor& acc, const FloatLeaf& leaf, LeafFactors& out) const;
 
     const Volume& volume() const { return volume_; }
 

@@ -285,19 +285,26 @@ namespace {
 /// A voxel's classification as every stream path computes it: the baked table's, then shaded
 /// (VoxelShader, the same factors the reference reads) when shading is on, then the emission
 /// grid's term added (after shading: emitted light is not lit; docs/emission.md). One per block:
-/// it holds the tree accessors, and blocks run on any thread.
+/// it holds the tree accessors, and blocks run on any thread. A shaded leaf's factors are found
+/// for the whole leaf at once (@p vectorShading, VoxelShader::shadeLeaf: 8 voxels a vector, the
+/// same factors), voxel by voxel otherwise.
 class VoxelClassifier {
 public:
     VoxelClassifier(const Volume& volume, const ClassificationTable& table, const VoxelShader* shader,
-                    const EmissionSource* emission)
+                    const EmissionSource* emission, const openvdb::FloatTree::LeafNodeType* leaf, bool vectorShading)
         : table_(table), shader_(shader), emission_(emission) {
-        if (shader_) shaderAcc_.emplace(*volume.tree);
+        if (shader_) {
+            shaderAcc_.emplace(*volume.tree);
+            leafShaded_ = leaf && vectorShading && shader_->shadeLeaf(*shaderAcc_, *leaf, factors_);
+        }
         if (emission_) emissionAcc_.emplace(emission_->accessor());
     }
     Classified operator()(const openvdb::FloatTree::LeafNodeType* leaf, openvdb::Index n, const openvdb::Coord& ijk,
                           float value) {
         Classified cls = table_(value);
-        if (shader_ && cls.sigma > 0.f) cls = applyShading(cls, shader_->shadeDrawn(*shaderAcc_, leaf, n, ijk));
+        if (shader_ && cls.sigma > 0.f)
+            cls = applyShading(cls, leafShaded_ ? openvdb::Vec3f(factors_.diffuse[n], factors_.specular[n], factors_.opacity[n])
+                                                : shader_->shadeDrawn(*shaderAcc_, leaf, n, ijk));
         return emission_ ? applyEmission(cls, emission_->at(*emissionAcc_, ijk)) : cls;
     }
 
@@ -307,6 +314,8 @@ private:
     const EmissionSource* emission_;
     std::optional<VoxelShader::Accessor> shaderAcc_;
     std::optional<EmissionSource::Accessor> emissionAcc_;
+    bool leafShaded_ = false;
+    LeafFactors factors_;  // when leafShaded_: the block's leaf's factors, by voxel offset n
 };
 }  // namespace
 
@@ -316,7 +325,7 @@ private:
 /// parallel extraction, costs only the voxels drawn.
 template <typename Keep, typename Fn>
 void VoxelStream::forEachActive(const Block& b, Keep&& keep, Fn&& fn) const {
-    VoxelClassifier classifyAt(volume_, table_, shader_, emission_);  // per block: blocks run on any thread
+    VoxelClassifier classifyAt(volume_, table_, shader_, emission_, b.leaf, options_.vectorShading);  // per block: blocks run on any thread
     const auto classify = [&](openvdb::Index n, float value) {
         return classifyAt(b.leaf, n, b.origin.offsetBy(int(n >> 6), int((n >> 3) & 7), int(n & 7)), value);
     };
@@ -496,9 +505,9 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
 namespace {
 template <typename Fn>
 void forEachRow(const auto& b, const Volume& volume, const ClassificationTable& table, const VoxelShader* shader,
-                const EmissionSource* emission, Fn&& fn) {
+                const EmissionSource* emission, bool vectorShading, Fn&& fn) {
     constexpr int kDim = kBlockDim;
-    VoxelClassifier classify(volume, table, shader, emission);
+    VoxelClassifier classify(volume, table, shader, emission, b.leaf, vectorShading);
     std::array<float, kDim> sigma;
     std::array<glm::vec3, kDim> color;
     const float* values = b.leaf ? b.leaf->buffer().data() : nullptr;
@@ -618,7 +627,7 @@ void VoxelStream::computeCellMoments(const Block& b, int level, CellMoments* acc
         return;
     }
     std::fill_n(acc, cells * cells * cells, Moments{});  // the row sums below add to zero
-    forEachRow(b, volume_, table_, shader_, emission_, [&](int x, int y, const std::array<float, kBlockDim>& sigma, const std::array<glm::vec3, kBlockDim>& color) {
+    forEachRow(b, volume_, table_, shader_, emission_, options_.vectorShading, [&](int x, int y, const std::array<float, kBlockDim>& sigma, const std::array<glm::vec3, kBlockDim>& color) {
         const float dx = float(x & (side - 1)) - half, dy = float(y & (side - 1)) - half;
         Moments* row = &acc[size_t(((x >> level) * cells + (y >> level)) * cells)];
         for (int cz = 0; cz < cells; ++cz) {

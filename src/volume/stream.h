@@ -140,6 +140,9 @@ struct StreamOptions {
     /// Plain leaves' voxels through the vectorised extraction (volume/leaf_extract.h); false: the
     /// voxel-by-voxel path it is tested against (the same records, bit for bit).
     bool vectorExtract = true;
+    /// Shaded leaves' factors a whole leaf at once (VoxelShader::shadeLeaf, shading/shade_leaf.h);
+    /// false: voxel by voxel (shadeDrawn), the oracle (the same factors, bit for bit).
+    bool vectorShading = true;
     /// With an occlusion test (next()'s partlyHidden): a leaf drawn voxel by voxel whose screen
     /// rectangle is partly behind finished pixels is tested octant by octant (4³ voxels), and the
     /// hidden octants are neither classified nor projected (counted as occluded). False: the whole

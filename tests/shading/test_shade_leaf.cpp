@@ -1,0 +1,161 @@
+// tests/shading/test_shade_leaf.cpp — VoxelShader::shadeLeaf (shading/shade_leaf.h) against the
+// voxel-by-voxel factors (shadeDrawn) it must equal bit for bit: leaves beside leaves, active and
+// inactive tiles and the background; inactive and non-finite values; an eye far off, beside and
+// exactly on a voxel; headlight and a directional light; gradient opacity; an affine transform.
+// And in the stream: the same records with the whole-leaf factors as voxel by voxel.
+#include <gtest/gtest.h>
+
+#include <hwy/targets.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "camera/camera.h"
+#include "shading/shading_field.h"
+#include "volume/generate.h"
+#include "volume/stream.h"
+
+namespace vdbsplat {
+namespace {
+
+/// Runs @p body on the best target and, where the CPU has more, on AVX2 (8-float vectors).
+template <typename Body>
+void onBestAndAvx2(Body body) {
+    if (!leafShadingSupported()) GTEST_SKIP() << "this CPU has no 8-float vectors (voxel-by-voxel shading only)";
+    {
+        SCOPED_TRACE("best target");
+        body();
+    }
+#if HWY_ARCH_X86
+    if ((hwy::SupportedTargets() & HWY_AVX2) && hwy::SupportedTargets() != HWY_AVX2) {
+        hwy::SetSupportedTargetsForTest(HWY_AVX2);
+        ASSERT_TRUE(leafShadingSupported());
+        SCOPED_TRACE("AVX2");
+        body();
+        hwy::SetSupportedTargetsForTest(0);  // back to what the CPU has
+    }
+#endif
+}
+
+/// Leaves of random values (some inactive, one NaN, one +∞) around the leaf at the origin, an
+/// active and an inactive tile beside others, and an affine, off-axis index-to-world map.
+Volume mixedVolume() {
+    initOpenVdb();
+    auto grid = openvdb::FloatGrid::create(0.05f);
+    auto acc = grid->getAccessor();
+    uint32_t state = 12345;
+    const auto next = [&] { return state = state * 1664525u + 1013904223u, float(state >> 8) / float(1u << 24); };
+    for (int i = -8; i < 16; ++i)
+        for (int j = -8; j < 16; ++j)
+            for (int k = 0; k < 16; ++k) {
+                const float u = next();
+                if (u < 0.15f) continue;  // left as background
+                const openvdb::Coord c(i, j, k);
+                acc.setValue(c, 1.3f * next() - 0.15f);  // some beyond [0, 1]: clamped
+                if (u < 0.25f) acc.setValueOff(c);
+            }
+    acc.setValueOn(openvdb::Coord(3, 4, 5), std::numeric_limits<float>::quiet_NaN());
+    acc.setValueOn(openvdb::Coord(9, 2, 7), std::numeric_limits<float>::infinity());
+    // Beside the leaf at (0, 0, 16)… an active tile, and an inactive one beside (16, 0, 0).
+    grid->tree().addTile(1, openvdb::Coord(0, 0, 24), 0.7f, true);
+    grid->tree().addTile(1, openvdb::Coord(16, 0, 8), 0.9f, false);
+    acc.setValueOn(openvdb::Coord(16, 3, 3), 0.6f);  // a leaf beside (8, 0, 0)
+    openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
+    m.preScale(openvdb::Vec3d(0.8, 1.1, 0.9));
+    m.preRotate(openvdb::math::X_AXIS, 0.3);
+    m.preRotate(openvdb::math::Y_AXIS, -0.7);
+    m.postTranslate(openvdb::Vec3d(2.5, -1.0, 4.0));
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(m));
+    return makeVolume(grid, "mixed");
+}
+
+ClassificationTable rampTable() {
+    std::vector<Classified> entries(ClassificationTable::kSize);
+    for (int i = 0; i < ClassificationTable::kSize; ++i) {
+        const float t = float(i) / float(ClassificationTable::kSize - 1);
+        entries[size_t(i)] = {glm::vec3(t, 1.f - t, 0.5f), t < 0.1f ? 0.f : 2.f * t};
+    }
+    return ClassificationTable(entries, 0.f, 1.f);
+}
+
+bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+/// Every voxel of every leaf: shadeLeaf's factors against shadeDrawn's, bit for bit.
+void expectEveryLeafAsVoxelByVoxel(const Volume& v, const VoxelShader& shader, uint64_t& lit, uint64_t& compared) {
+    VoxelShader::Accessor acc(*v.tree);
+    LeafFactors f;
+    for (auto leaf = v.tree->cbeginLeaf(); leaf; ++leaf) {
+        ASSERT_TRUE(shader.shadeLeaf(acc, *leaf, f));
+        for (openvdb::Index n = 0; n < LeafFactors::kVoxels; ++n) {
+            const openvdb::Vec3f want = shader.shadeDrawn(acc, &*leaf, n, leaf->offsetToGlobalCoord(n));
+            SCOPED_TRACE(testing::Message() << "leaf " << leaf->origin() << " voxel " << n);
+            ASSERT_TRUE(sameBits(f.diffuse[n], want[0])) << f.diffuse[n] << " " << want[0];
+            ASSERT_TRUE(sameBits(f.specular[n], want[1])) << f.specular[n] << " " << want[1];
+            ASSERT_TRUE(sameBits(f.opacity[n], want[2])) << f.opacity[n] << " " << want[2];
+            lit += want[1] > 0.f;
+            ++compared;
+        }
+    }
+}
+
+TEST(ShadeLeaf, EqualsTheVoxelByVoxelFactorsBitForBit) {
+    const Volume v = mixedVolume();
+    const ClassificationTable table = rampTable();
+    ShadingSettings phong = ShadingSettings::ctPreset();
+    ShadingSettings lightAndOpacity = phong;
+    lightAndOpacity.hasLight = true, lightAndOpacity.light = glm::dvec3(0.3, -0.8, 0.5);
+    lightAndOpacity.gradientOpacity = 25.f, lightAndOpacity.shininess = 7.5f;
+    ShadingSettings opacityOnly;
+    opacityOnly.gradientOpacity = 40.f;
+    const glm::dvec3 onAVoxel(v.indexToWorld * glm::dvec4(2.0, 5.0, 6.0, 1.0));  // the eye exactly at a voxel centre
+    const glm::dvec3 eyes[] = {{40.0, -25.0, 60.0}, {3.1, 2.2, 5.7}, onAVoxel};
+    uint64_t lit = 0, compared = 0;
+    onBestAndAvx2([&] {
+        for (const ShadingSettings& s : {phong, lightAndOpacity, opacityOnly})
+            for (const glm::dvec3& eye : eyes)
+                for (const float hi : {1.f, 0.6f}) {  // two normalisations
+                    const VoxelShader shader(v, table, 0.f, hi, eye, s);
+                    expectEveryLeafAsVoxelByVoxel(v, shader, lit, compared);
+                }
+    });
+    EXPECT_GT(compared, 100000u);
+    EXPECT_GT(lit, compared / 10);  // the specular term is exercised, not just the unshaded lanes
+}
+
+// In the stream, shaded: every record the same with the whole-leaf factors as voxel by voxel, at a
+// framed view (voxels) and a far one (level-of-detail cells).
+TEST(ShadeLeaf, StreamRecordsEqualTheVoxelByVoxelShading) {
+    if (!leafShadingSupported()) GTEST_SKIP() << "this CPU has no 8-float vectors (voxel-by-voxel shading only)";
+    const Volume v = makeVolume(makeCloud(60000, 3), "cloud");
+    const ClassificationTable table = rampTable();
+    glm::dvec3 lo, hi;
+    v.worldBounds(lo, hi);
+    for (const double distance : {1.0, 8.0}) {
+        CameraSpec spec;
+        spec.width = spec.height = 256;
+        spec.distance = distance;
+        const Camera camera = makeCamera(spec, lo, hi);
+        const VoxelShader shader(v, table, 0.f, 1.f, camera.eye(), ShadingSettings::ctPreset());
+        std::vector<std::vector<float>> runs;
+        for (const bool vector : {true, false}) {
+            StreamOptions o;
+            o.vectorShading = vector;
+            o.pointBelowPx = 1.0;
+            VoxelStream stream(v, camera, table, o, &shader);
+            VoxelBatch batch;
+            std::vector<float> r;
+            while (stream.next(batch))
+                for (size_t i = 0; i < batch.size(); ++i)
+                    r.insert(r.end(), {batch.viewPos[i].x, batch.viewPos[i].y, batch.viewPos[i].z, batch.sigma[i],
+                                       batch.color[i].x, batch.color[i].y, batch.color[i].z});
+            runs.push_back(std::move(r));
+        }
+        SCOPED_TRACE("distance " + std::to_string(distance));
+        EXPECT_GT(runs[0].size(), 7 * size_t(1000));
+        EXPECT_EQ(runs[0], runs[1]);
+    }
+}
+
+}  // namespace
+}  // namespace vdbsplat
