@@ -13,6 +13,7 @@
 
 #include <hwy/highway.h>
 
+#include "shading/shade_leaf.h"
 #include "volume/transfer_function.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -124,6 +125,23 @@ struct ClassifyLanes {
                  hn::Sub(x, at(pieces->knot)));
     }
 };
+
+/// Shading's factors (shading/shade_leaf.h) on the classified lanes of voxel n, as applyShading
+/// does for one voxel: colour c·D + S, σ·G; a σ·G that is not > 0 (0, or NaN from a non-finite
+/// neighbour's gradient) becomes 0, which the voxel-by-voxel paths skip. @p factors: nullptr:
+/// unshaded, nothing changes.
+template <class D>
+HWY_INLINE void ApplyFactors(D d, const LeafFactors* factors, int n, hwy::HWY_NAMESPACE::Vec<D>& sigma,
+                             hwy::HWY_NAMESPACE::Vec<D>& r, hwy::HWY_NAMESPACE::Vec<D>& g, hwy::HWY_NAMESPACE::Vec<D>& b) {
+    namespace hn = hwy::HWY_NAMESPACE;
+    if (!factors) return;
+    const auto diffuse = hn::LoadU(d, factors->diffuse + n), specular = hn::LoadU(d, factors->specular + n);
+    r = hn::Add(hn::Mul(r, diffuse), specular);
+    g = hn::Add(hn::Mul(g, diffuse), specular);
+    b = hn::Add(hn::Mul(b, diffuse), specular);
+    sigma = hn::Mul(sigma, hn::LoadU(d, factors->opacity + n));
+    sigma = hn::IfThenElseZero(hn::Gt(sigma, hn::Zero(d)), sigma);
+}
 
 /// A leaf's active lanes at voxel n (a vector of whole rows: n = x·64 + y·8): finite values,
 /// and on in @p maskWords (nullptr: a dense leaf).

@@ -23,7 +23,7 @@ bool LeafExtractSupported() { return WholeRowsSupported(hn::ScalableTag<float>()
 /// in double on half as many lanes, then rounded to float as the scalar path's casts do.
 template <class D>
 size_t ExtractRows(D d, const float* values, const uint64_t* maskWords, const ClassificationTable& table,
-                   const glm::dmat4& M, const glm::ivec3& origin, const LeafRecords& out) {
+                   const glm::dmat4& M, const glm::ivec3& origin, const LeafRecords& out, const LeafFactors* factors) {
 #if HWY_TARGET != HWY_SCALAR
     if constexpr (kWholeRows<D>) {
         using V = hn::Vec<D>;
@@ -56,6 +56,7 @@ size_t ExtractRows(D d, const float* values, const uint64_t* maskWords, const Cl
                 if (classify.AllTransparent(index)) continue;
                 V sigma, red, green, blue;
                 classify(index, active, sigma, red, green, blue);
+                ApplyFactors(d, factors, n, sigma, red, green, blue);
                 const auto keep = hn::Gt(sigma, zero);  // 0 where inactive
                 if (hn::AllFalse(d, keep)) continue;
                 VD p[2][3], dist[2];
@@ -84,14 +85,15 @@ size_t ExtractRows(D d, const float* values, const uint64_t* maskWords, const Cl
     } else
 #endif
     {
-        (void)d, (void)values, (void)maskWords, (void)table, (void)M, (void)origin, (void)out;
+        (void)d, (void)values, (void)maskWords, (void)table, (void)M, (void)origin, (void)out, (void)factors;
         return 0;
     }
 }
 
 size_t ExtractLeafVoxelsImpl(const float* values, const uint64_t* maskWords, const ClassificationTable& table,
-                             const glm::dmat4& indexToView, const glm::ivec3& origin, const LeafRecords& out) {
-    return ExtractRows(hn::ScalableTag<float>(), values, maskWords, table, indexToView, origin, out);
+                             const glm::dmat4& indexToView, const glm::ivec3& origin, const LeafRecords& out,
+                             const LeafFactors* factors) {
+    return ExtractRows(hn::ScalableTag<float>(), values, maskWords, table, indexToView, origin, out, factors);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -107,8 +109,9 @@ HWY_EXPORT(LeafExtractSupported);
 bool leafExtractSupported() { return HWY_DYNAMIC_DISPATCH(LeafExtractSupported)(); }
 
 size_t extractLeafVoxels(const float* values, const uint64_t* maskWords, const ClassificationTable& table,
-                         const glm::dmat4& indexToView, const glm::ivec3& origin, const LeafRecords& out) {
-    return HWY_DYNAMIC_DISPATCH(ExtractLeafVoxelsImpl)(values, maskWords, table, indexToView, origin, out);
+                         const glm::dmat4& indexToView, const glm::ivec3& origin, const LeafRecords& out,
+                         const LeafFactors* factors) {
+    return HWY_DYNAMIC_DISPATCH(ExtractLeafVoxelsImpl)(values, maskWords, table, indexToView, origin, out, factors);
 }
 
 }  // namespace vdbsplat

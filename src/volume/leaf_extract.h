@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 
+#include "shading/shade_leaf.h"
 #include "volume/transfer_function.h"
 
 namespace vdbsplat {
@@ -28,9 +29,11 @@ bool leafExtractSupported();
 
 /// @brief Writes the records of the leaf at index @p origin (its first voxel) whose @p values are in
 /// OpenVDB's order (n = x·64 + y·8 + z) and @p maskWords its 8 value-mask words (nullptr: dense),
-/// through @p indexToView; returns how many. @p table must not be empty(); leafExtractSupported()
+/// through @p indexToView; returns how many. With @p factors, each voxel is shaded as applyShading
+/// does (c·D + S, σ·G) before the σ > 0 test. @p table must not be empty(); leafExtractSupported()
 /// must hold.
 size_t extractLeafVoxels(const float* values, const uint64_t* maskWords, const ClassificationTable& table,
-                         const glm::dmat4& indexToView, const glm::ivec3& origin, const LeafRecords& out);
+                         const glm::dmat4& indexToView, const glm::ivec3& origin, const LeafRecords& out,
+                         const LeafFactors* factors = nullptr);
 
 }  // namespace vdbsplat

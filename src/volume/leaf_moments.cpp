@@ -38,7 +38,7 @@ auto FoldRows(D d, hn::Vec<D> v) {
 /// do not exist, never instantiate the body).
 template <class D>
 void RowMoments(D d, const float* values, const uint64_t* maskWords, const ClassificationTable& table, int level,
-                CellMoments* out) {
+                CellMoments* out, const LeafFactors* factors) {
 #if HWY_TARGET != HWY_SCALAR  // one lane: no halves or lane pairs to name (and kWholeRows is false)
     if constexpr (kWholeRows<D>) {
         const hn::RebindToSigned<decltype(d)> di;
@@ -75,6 +75,7 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
                         if (classify.AllTransparent(index)) continue;
                         V sigma, red, green, blue;
                         classify(index, active, sigma, red, green, blue);
+                        ApplyFactors(d, factors, n, sigma, red, green, blue);
                         count = hn::Add(count, hn::IfThenElseZero(hn::Gt(sigma, zero), hn::Set(d, 1.f)));
                         Er = hn::MulAdd(sigma, red, Er);
                         Eg = hn::MulAdd(sigma, green, Eg);
@@ -118,13 +119,13 @@ void RowMoments(D d, const float* values, const uint64_t* maskWords, const Class
     } else
 #endif
     {
-        (void)d, (void)values, (void)maskWords, (void)table, (void)level, (void)out;
+        (void)d, (void)values, (void)maskWords, (void)table, (void)level, (void)out, (void)factors;
     }
 }
 
 void LeafMomentsImpl(const float* values, const uint64_t* maskWords, const ClassificationTable& table, int level,
-                     CellMoments* out) {
-    RowMoments(hn::ScalableTag<float>(), values, maskWords, table, level, out);
+                     CellMoments* out, const LeafFactors* factors) {
+    RowMoments(hn::ScalableTag<float>(), values, maskWords, table, level, out, factors);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -140,8 +141,8 @@ HWY_EXPORT(LeafMomentsSupported);
 bool leafMomentsSupported() { return HWY_DYNAMIC_DISPATCH(LeafMomentsSupported)(); }
 
 void leafMoments(const float* values, const uint64_t* maskWords, const ClassificationTable& table, int level,
-                 CellMoments* out) {
-    HWY_DYNAMIC_DISPATCH(LeafMomentsImpl)(values, maskWords, table, level, out);
+                 CellMoments* out, const LeafFactors* factors) {
+    HWY_DYNAMIC_DISPATCH(LeafMomentsImpl)(values, maskWords, table, level, out, factors);
 }
 
 }  // namespace vdbsplat

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 
+#include "shading/shade_leaf.h"
 #include "volume/transfer_function.h"
 
 namespace vdbsplat {
@@ -29,10 +30,11 @@ bool leafMomentsSupported();
 /// @brief The moments of every cell of (2^@p level)³ voxels of one 8³ leaf (@p level 1–3), about
 /// each cell's centre: @p values in OpenVDB's order (n = x·64 + y·8 + z), @p maskWords its 8
 /// value-mask words (word x holds bit y·8 + z), or nullptr for a dense leaf; each active value
-/// classified exactly as ClassificationTable::operator() does (non-finite: σ = 0). Writes
-/// (8 >> level)³ cells to @p out, cell (cx, cy, cz) at (cx·c + cy)·c + cz. @p table must not be
-/// empty(); leafMomentsSupported() must hold.
+/// classified exactly as ClassificationTable::operator() does (non-finite: σ = 0), then, with
+/// @p factors, shaded as applyShading does (c·D + S, σ·G). Writes (8 >> level)³ cells to @p out,
+/// cell (cx, cy, cz) at (cx·c + cy)·c + cz. @p table must not be empty(); leafMomentsSupported()
+/// must hold.
 void leafMoments(const float* values, const uint64_t* maskWords, const ClassificationTable& table, int level,
-                 CellMoments* out);
+                 CellMoments* out, const LeafFactors* factors = nullptr);
 
 }  // namespace vdbsplat

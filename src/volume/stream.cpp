@@ -450,6 +450,15 @@ void VoxelStream::extract(const Block& b, VoxelBatch& out, StreamCounts& counts,
     emitCells(b, k, cellsWithMass(up, parents * parents * parents), coarse.data(), false, out, counts);
 }
 
+// A shaded leaf's factors for all its voxels at once (VoxelShader::shadeLeaf), for the vectorised
+// extraction and sums: false where the stream shades voxel by voxel (the oracle, or no 8-float
+// vectors).
+bool VoxelStream::shadeWholeLeaf(const Block& b, LeafFactors& factors) const {
+    if (!shader_ || !b.leaf || !options_.vectorShading) return false;
+    VoxelShader::Accessor acc(*volume_.tree);  // per block: blocks run on any thread
+    return shader_->shadeLeaf(acc, *b.leaf, factors);
+}
+
 // coarse: per level-1 cell (x>>1, y>>1, z>>1) its weight w_c at level 1; the voxels take 1 − w_c
 // (none drawn, nor classified, where w_c = 1) and carry the counts where w_c < ½. nullptr: w_c = 0.
 void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch& out, const uint64_t* visible) const {
@@ -466,7 +475,9 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
     size_t k = first;
     // A plain leaf (no shading, emission or blend weights): a vector of rows at a time
     // (volume/leaf_extract.h), the same records as the voxel-by-voxel path below.
-    if (!coarse && b.leaf && !shader_ && !emission_ && options_.vectorExtract && table_.entries() && leafExtractSupported()) {
+    LeafFactors factors;  // a shaded leaf's (VoxelShader::shadeLeaf)
+    if (!coarse && b.leaf && !emission_ && options_.vectorExtract && table_.entries() && leafExtractSupported() &&
+        (!shader_ || shadeWholeLeaf(b, factors))) {
         const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE && !visible;
         std::array<uint64_t, 8> words;
         for (int x = 0; x < 8; ++x)
@@ -474,7 +485,7 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
         const LeafRecords to{out.viewPos.data() + first, out.distance.data() + first, out.sigma.data() + first,
                              out.color.data() + first};
         k += extractLeafVoxels(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, indexToView_,
-                               glm::ivec3(b.origin.x(), b.origin.y(), b.origin.z()), to);
+                               glm::ivec3(b.origin.x(), b.origin.y(), b.origin.z()), to, shader_ ? &factors : nullptr);
         std::fill(out.spread.begin() + ptrdiff_t(first), out.spread.begin() + ptrdiff_t(k), 0.f);
         if (options_.depthSpread) std::fill(out.depthSpread.begin() + ptrdiff_t(first), out.depthSpread.begin() + ptrdiff_t(k), 0.f);
         std::fill(out.members.begin() + ptrdiff_t(first), out.members.begin() + ptrdiff_t(k), 1u);
@@ -616,14 +627,17 @@ void VoxelStream::computeCellMoments(const Block& b, int level, CellMoments* acc
     using Moments = CellMoments;
     const int side = 1 << level, cells = b.dim >> level;
     const float half = 0.5f * float(side - 1);
-    // Leaves without shading or emission: the vectorised sums (leaf_moments.h; 2–4× the scalar rows).
-    const bool vectorised = level >= 1 && b.leaf && !shader_ && !emission_ && table_.entries() &&
-                            options_.vectorLeafMoments && leafMomentsSupported();
+    // Leaves without emission: the vectorised sums (leaf_moments.h; 2–4× the scalar rows), shaded
+    // by the whole leaf's factors where shading is on.
+    LeafFactors factors;
+    const bool vectorised = level >= 1 && b.leaf && !emission_ && table_.entries() && options_.vectorLeafMoments &&
+                            leafMomentsSupported() && (!shader_ || shadeWholeLeaf(b, factors));
     if (vectorised) {
         const bool dense = b.voxels == openvdb::FloatTree::LeafNodeType::SIZE;
         std::array<uint64_t, 8> words;
         for (int x = 0; x < 8; ++x) words[size_t(x)] = b.leaf->getValueMask().template getWord<uint64_t>(openvdb::Index(x));
-        leafMoments(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, level, acc);  // writes every cell
+        leafMoments(b.leaf->buffer().data(), dense ? nullptr : words.data(), table_, level, acc,  // writes every cell
+                    shader_ ? &factors : nullptr);
         return;
     }
     std::fill_n(acc, cells * cells * cells, Moments{});  // the row sums below add to zero

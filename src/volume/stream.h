@@ -277,6 +277,7 @@ private:
     bool keepsLevel(const Block& b, int level) const;  // this level's cells of b are kept between renders
     bool momentsKept(const Block& b) const;  // drawn at one level from kept cells (reads no voxel)
     void computeCellMoments(const Block& b, int level, CellMoments* acc) const;  // writes all of b's cells at level
+    bool shadeWholeLeaf(const Block& b, LeafFactors& factors) const;  // a shaded leaf's factors at once
     void prepareMomentCache(size_t blocks);  // keys (or empties) the kept moments for this grid and table
     void emitCells(const Block& b, int level, PackedCells acc, const float* coarse, bool fineSide,
                    VoxelBatch& out, StreamCounts& counts) const;

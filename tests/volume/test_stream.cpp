@@ -521,6 +521,7 @@ TEST(Stream, BlendedLevelsKeepTheEnergy) {
 
 #include <hwy/targets.h>
 
+#include "shading/shading_field.h"
 #include "volume/leaf_extract.h"
 #include "volume/leaf_moments.h"
 
@@ -530,7 +531,7 @@ namespace {
 // The vectorised whole-leaf sums against the same sums in double, one voxel at a time: a
 // partly active leaf (mask words), a dense one (no mask), values outside the table's range,
 // NaN and infinity (σ = 0, not counted), and a colour-varying table.
-void expectLeafMomentsMatchTheSums(const ClassificationTable& table);
+void expectLeafMomentsMatchTheSums(const ClassificationTable& table, bool shaded = false);
 
 /// Runs @p body on the widest target this CPU has, and again on AVX2 (8 lanes: one row per
 /// vector, lane pairs of 4 doubles) where the CPU has wider ones, so that both row layouts of the
@@ -596,8 +597,35 @@ RandomLeaf randomLeaf(int trial, uint32_t& state, float infinity, float activeSh
     return leaf;
 }
 
+/// Shading factors for a leaf's voxels: D in [0.2, 1.4], S in [0, 0.3], G in [0, 1] with some
+/// G exactly 0 and one NaN (as a NaN neighbour makes it).
+LeafFactors randomFactors(int trial) {
+    uint32_t state = 7u + uint32_t(trial);
+    const auto rnd = [&] { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1 << 24); };
+    LeafFactors f;
+    for (int n = 0; n < LeafFactors::kVoxels; ++n) {
+        f.diffuse[n] = 0.2f + 1.2f * rnd(), f.specular[n] = 0.3f * rnd(), f.opacity[n] = rnd();
+        if (n % 11 == trial % 11) f.opacity[n] = 0.f;
+    }
+    f.opacity[(trial * 37) % 512] = std::numeric_limits<float>::quiet_NaN();
+    return f;
+}
+
+/// A voxel's classification shaded as the stream's voxel-by-voxel path does (VoxelClassifier:
+/// applyShading where σ > 0); @p factors nullptr: as it is.
+Classified shadedAs(const Classified& c, const LeafFactors* factors, int n) {
+    if (!factors || !(c.sigma > 0.f)) return c;
+    return applyShading(c, openvdb::Vec3f(factors->diffuse[n], factors->specular[n], factors->opacity[n]));
+}
+
 TEST(LeafMoments, MatchTheSumsVoxelByVoxel) {
     onBestAndAvx2(leafMomentsSupported, [] { expectLeafMomentsMatchTheSums(leafTestTable(0.1f)); });
+}
+
+// With shading's factors (shading/shade_leaf.h): each voxel c·D + S and σ·G, as applyShading, with
+// factors that zero some σ and make one NaN (a non-finite neighbour's gradient: not drawn).
+TEST(LeafMoments, MatchTheShadedSums) {
+    onBestAndAvx2(leafMomentsSupported, [] { expectLeafMomentsMatchTheSums(leafTestTable(0.1f), true); });
 }
 
 TEST(LeafMoments, MatchTheSumsThroughLinearPieces) {
@@ -607,20 +635,21 @@ TEST(LeafMoments, MatchTheSumsThroughLinearPieces) {
     onBestAndAvx2(leafMomentsSupported, [&] { expectLeafMomentsMatchTheSums(table); });
 }
 
-void expectLeafMomentsMatchTheSums(const ClassificationTable& table) {
+void expectLeafMomentsMatchTheSums(const ClassificationTable& table, bool shaded) {
     uint32_t state = 99;
     for (int trial = 0; trial < 40; ++trial) {
         const auto [values, words] = randomLeaf(trial, state, -std::numeric_limits<float>::infinity(), 0.7f);
         const bool dense = trial % 4 == 0;
         const int level = 1 + trial % 3, side = 1 << level, cells = 8 >> level;
         const float half = 0.5f * float(side - 1);
+        const LeafFactors factors = randomFactors(trial);
         std::array<CellMoments, 64> got;
-        leafMoments(values.data(), dense ? nullptr : words.data(), table, level, got.data());
+        leafMoments(values.data(), dense ? nullptr : words.data(), table, level, got.data(), shaded ? &factors : nullptr);
         struct Sums { double m = 0, e[3] = {}, f[3] = {}, s2[6] = {}; uint32_t count = 0; };
         std::array<Sums, 64> want{};
         for (int n = 0; n < 512; ++n) {
             if (!dense && !(words[size_t(n >> 6)] >> (n & 63) & 1)) continue;
-            const Classified c = table(values[size_t(n)]);
+            const Classified c = shadedAs(table(values[size_t(n)]), shaded ? &factors : nullptr, n);
             if (!(c.sigma > 0.f)) continue;
             const int x = n >> 6, y = (n >> 3) & 7, z = n & 7;
             Sums& w = want[size_t(((x >> level) * cells + (y >> level)) * cells + (z >> level))];
@@ -653,10 +682,15 @@ void expectLeafMomentsMatchTheSums(const ClassificationTable& table) {
 // table, not masked off), its view position and distance in glm's double order rounded to
 // float, σ and colour as ClassificationTable::operator(). Partly active and dense leaves, a
 // camera off every axis; on the widest target and on AVX2 (one row per vector) where wider exist.
-void expectLeafExtractionMatchesTheVoxels(const ClassificationTable& table);
+void expectLeafExtractionMatchesTheVoxels(const ClassificationTable& table, bool shaded = false);
 
 TEST(LeafExtract, EqualsTheVoxelByVoxelRecords) {
     onBestAndAvx2(leafExtractSupported, [] { expectLeafExtractionMatchesTheVoxels(leafTestTable(0.3f)); });
+}
+
+// Shaded by a leaf's factors (c·D + S, σ·G, then the σ > 0 test), bit for bit.
+TEST(LeafExtract, EqualsTheShadedVoxelByVoxelRecords) {
+    onBestAndAvx2(leafExtractSupported, [] { expectLeafExtractionMatchesTheVoxels(leafTestTable(0.3f), true); });
 }
 
 // The same through a table's linear pieces: σ and colour equal LinearPieces::operator() bit for
@@ -690,7 +724,7 @@ TEST(LeafExtract, StreamRecordsEqualTheVoxelByVoxelPath) {
     EXPECT_EQ(runs[0], runs[1]);
 }
 
-void expectLeafExtractionMatchesTheVoxels(const ClassificationTable& table) {
+void expectLeafExtractionMatchesTheVoxels(const ClassificationTable& table, bool shaded) {
     // An index-to-view transform off every axis, with a translation and an uneven scale (as
     // VoxelStream's worldToView · indexToWorld; any affine map).
     glm::dmat4 indexToView(1.0);
@@ -707,12 +741,14 @@ void expectLeafExtractionMatchesTheVoxels(const ClassificationTable& table) {
         const glm::ivec3 origin(8 * (trial % 3) - 8, 8 * (trial % 5), -16 + 8 * (trial % 7));
         std::vector<glm::vec3> pos(512), color(512);
         std::vector<float> distance(512), sigma(512);
+        const LeafFactors factors = randomFactors(trial);
         const size_t n = extractLeafVoxels(values.data(), dense ? nullptr : words.data(), table, indexToView, origin,
-                                           LeafRecords{pos.data(), distance.data(), sigma.data(), color.data()});
+                                           LeafRecords{pos.data(), distance.data(), sigma.data(), color.data()},
+                                           shaded ? &factors : nullptr);
         size_t k = 0;
         for (int i = 0; i < 512; ++i) {
             if (!dense && !(words[size_t(i >> 6)] >> (i & 63) & 1)) continue;
-            const Classified c = table(values[size_t(i)]);
+            const Classified c = shadedAs(table(values[size_t(i)]), shaded ? &factors : nullptr, i);
             if (!(c.sigma > 0.f)) continue;
             SCOPED_TRACE("trial " + std::to_string(trial) + ", voxel " + std::to_string(i));
             ASSERT_LT(k, n);
