@@ -10,8 +10,10 @@
 
 #include <bit>
 #include <cmath>
+#include <cstring>
 
 #include "shading/shade_leaf.h"
+#include "volume/classify-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace vdbsplat {
@@ -60,12 +62,46 @@ void ShadeRows(D d, const LeafShadingInput& in, LeafFactors& out) {
         const V lx = hn::Set(d, in.toLight.x), ly = hn::Set(d, in.toLight.y), lz = hn::Set(d, in.toLight.z);
         const V ambient = hn::Set(d, s.ambient), diffuse = hn::Set(d, s.diffuse), specular = hn::Set(d, s.specular);
         const bool phong = s.mode == ShadingMode::Phong;
-        constexpr int kS = LeafShadingInput::kSide;
+        constexpr int kS = 10;  // the padded grid's side
+        // The normalised values on the padded grid (voxel (x, y, z) at ((x+1)·10 + y+1)·10 + z+1): the
+        // leaf's rows (an inactive voxel reads as the background), then the faces' layers, each
+        // normalised as gradientOf does, (v − lo)·scale clamped to [0, 1].
+        alignas(64) float padded[kS * kS * kS];
+        const V lo = hn::Set(d, in.lo), scale = hn::Set(d, in.scale), background = hn::Set(d, in.background);
+        const auto normalised = [&](V v) { return clamp01(hn::Mul(hn::Sub(v, lo), scale)); };
+        const auto rowMask = [&](int n) {  // the active lanes of row n / 8
+            uint8_t byte[8] = {uint8_t(in.maskWords[n >> 6] >> (n & 63))};
+            return hn::LoadMaskBits(d, byte);
+        };
+        for (int n = 0; n < 512; n += 8) {
+            const V v = hn::IfThenElse(rowMask(n), hn::LoadU(d, in.values + n), background);
+            hn::StoreU(normalised(v), d, padded + ((n >> 6) + 1) * kS * kS + (((n >> 3) & 7) + 1) * kS + 1);
+        }
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                alignas(32) float layer[64];
+                for (int k = 0; k < 64; k += 8) hn::Store(normalised(hn::LoadU(d, in.faces[2 * axis + side] + k)), d, layer + k);
+                for (int u = 0; u < 8; ++u)
+                    for (int v = 0; v < 8; ++v) {
+                        int c[3];
+                        c[axis] = side == 0 ? 0 : kS - 1, c[(axis + 1) % 3] = u + 1, c[(axis + 2) % 3] = v + 1;
+                        padded[(c[0] * kS + c[1]) * kS + c[2]] = layer[u * 8 + v];
+                    }
+            }
+        // Rows and lanes the table may draw: active, and the table index not below transparentBelow.
+        const ClassifyLanes<D> classify(d, *in.table);
         alignas(32) float powBase[8], magnitudes[8];
         for (int x = 0; x < 8; ++x)
             for (int y = 0; y < 8; ++y) {
                 const int n = x * 64 + y * 8;
-                const float* row = in.padded + ((x + 1) * kS + (y + 1)) * kS + 1;  // voxel (x, y, 0)
+                const V value = hn::LoadU(d, in.values + n);
+                const auto active = hn::And(hn::IsFinite(value), rowMask(n));
+                const auto drawn = hn::AndNot(hn::Lt(classify.Index(value, active), classify.transparent), active);
+                if (hn::AllFalse(d, drawn)) {  // nothing here is drawn: unshaded
+                    hn::Store(one, d, out.diffuse + n), hn::Store(zero, d, out.specular + n), hn::Store(one, d, out.opacity + n);
+                    continue;
+                }
+                const float* row = padded + ((x + 1) * kS + (y + 1)) * kS + 1;  // voxel (x, y, 0)
                 // centralDifference: 0.5·(n₊ − n₋) per axis, from the normalised neighbours.
                 const V gx = hn::Mul(half, hn::Sub(hn::LoadU(d, row + kS * kS), hn::LoadU(d, row - kS * kS)));
                 const V gy = hn::Mul(half, hn::Sub(hn::LoadU(d, row + kS), hn::LoadU(d, row - kS)));
@@ -114,22 +150,27 @@ void ShadeRows(D d, const LeafShadingInput& in, LeafFactors& out) {
                 const V cosine = hn::Div(dot3(nx, ny, nz, hx, hy, hz), hl);
                 // std::max(0, c) as it is written, (0 < c) ? c : 0 (NaN gives 0).
                 hn::Store(hn::IfThenElseZero(hn::Lt(zero, cosine), cosine), d, powBase);
-                const auto specularLanes = hn::And(shaded, hn::And(lit, hn::Gt(hl, zero)));
+                const auto specularLanes = hn::And(drawn, hn::And(shaded, hn::And(lit, hn::Gt(hl, zero))));
                 alignas(32) float power[8] = {};
-                uint8_t bits[8] = {};
+                uint8_t bits[8] = {};  // specularLanes
                 hn::StoreMaskBits(d, specularLanes, bits);
                 for (unsigned m = bits[0]; m != 0; m &= m - 1) {  // libm's powf, per lane that needs it
                     const int z = std::countr_zero(m);
                     power[z] = std::pow(powBase[z], s.shininess);
                 }
                 const V spec = hn::Mul(specular, hn::Load(d, power));  // 0 where not lit: k_s · 0
-                hn::Store(hn::IfThenElse(shaded, hn::Add(one, hn::Mul(weight, hn::Sub(dTerm, one))), one), d, out.diffuse + n);
-                hn::Store(hn::IfThenElseZero(shaded, hn::Mul(weight, spec)), d, out.specular + n);
-                if (s.gradientOpacity > 0.f) {  // libm's expm1, per lane
+                const auto lighted = hn::And(drawn, shaded);  // the rest: (1, 0, G), or (1, 0, 1) where not drawn
+                hn::Store(hn::IfThenElse(lighted, hn::Add(one, hn::Mul(weight, hn::Sub(dTerm, one))), one), d, out.diffuse + n);
+                hn::Store(hn::IfThenElseZero(lighted, hn::Mul(weight, spec)), d, out.specular + n);
+                hn::Store(one, d, out.opacity + n);
+                if (s.gradientOpacity > 0.f) {  // libm's expm1, per lane drawn
                     hn::Store(magnitude, d, magnitudes);
-                    for (int z = 0; z < 8; ++z) out.opacity[n + z] = gradientOpacityFactor(magnitudes[z], s.gradientOpacity);
-                } else {
-                    hn::Store(one, d, out.opacity + n);
+                    uint8_t bits[8] = {};
+                    hn::StoreMaskBits(d, drawn, bits);
+                    for (unsigned m = bits[0]; m != 0; m &= m - 1) {
+                        const int z = std::countr_zero(m);
+                        out.opacity[n + z] = gradientOpacityFactor(magnitudes[z], s.gradientOpacity);
+                    }
                 }
             }
     } else

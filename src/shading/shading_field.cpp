@@ -88,37 +88,34 @@ openvdb::Vec3f VoxelShader::shadeDrawn(Accessor& acc, const FloatLeaf* leaf, ope
 bool VoxelShader::shadeLeaf(Accessor& acc, const FloatLeaf& leaf, LeafFactors& out) const {
     if (!leafShadingSupported()) return false;
     LeafShadingInput in;
-    const float scale = 1.f / (hi_ - lo_);  // as gradientOf normalises
-    constexpr int kS = LeafShadingInput::kSide, kDim = int(FloatLeaf::DIM);
-    const auto at = [&](int x, int y, int z) -> float& { return in.padded[((x + 1) * kS + (y + 1)) * kS + z + 1]; };
-    // The leaf's own values (an inactive one reads as the background), normalised.
-    const float* values = leaf.buffer().data();
-    for (openvdb::Index n = 0; n < FloatLeaf::SIZE; ++n)
-        at(int(n >> 6), int((n >> 3) & 7), int(n & 7)) = normalised(leaf.isValueOn(n) ? values[n] : background_, lo_, scale);
+    in.values = leaf.buffer().data();
+    for (int x = 0; x < 8; ++x) in.maskWords[x] = leaf.getValueMask().getWord<uint64_t>(openvdb::Index(x));
     // Each face neighbour's layer: from its leaf, or, where there is none, the tile or background
     // value that covers the whole 8³ region beside the leaf (what probeValue reads at each voxel).
     const openvdb::Coord origin = leaf.origin();
+    constexpr int kDim = int(FloatLeaf::DIM);
     for (int axis = 0; axis < 3; ++axis)
-        for (int side = -1; side <= 1; side += 2) {
+        for (int side = 0; side < 2; ++side) {
             openvdb::Coord q = origin;
-            q[axis] += side * kDim;
-            const int layer = side < 0 ? -1 : kDim, inNeighbour = side < 0 ? kDim - 1 : 0;
+            q[axis] += side == 0 ? -kDim : kDim;
+            float* layer = in.faces[2 * axis + side];
             const FloatLeaf* beside = acc.probeConstLeaf(q);
-            float tile = background_;
-            if (!beside && !acc.probeValue(q, tile)) tile = background_;
+            if (!beside) {
+                float tile = background_;
+                if (!acc.probeValue(q, tile)) tile = background_;
+                std::fill_n(layer, 64, tile);
+                continue;
+            }
             for (int u = 0; u < kDim; ++u)
                 for (int v = 0; v < kDim; ++v) {
-                    int c[3];  // (layer, u, v) arranged along (axis, the other two)
-                    c[axis] = inNeighbour, c[(axis + 1) % 3] = u, c[(axis + 2) % 3] = v;
-                    float raw = tile;
-                    if (beside) {
-                        const openvdb::Index m = FloatLeaf::coordToOffset(openvdb::Coord(c[0], c[1], c[2]));
-                        raw = beside->isValueOn(m) ? beside->getValue(m) : background_;
-                    }
-                    c[axis] = layer;
-                    at(c[0], c[1], c[2]) = normalised(raw, lo_, scale);
+                    openvdb::Coord c;  // in the neighbour: its last layer (−) or first (+) along axis
+                    c[axis] = side == 0 ? kDim - 1 : 0, c[(axis + 1) % 3] = u, c[(axis + 2) % 3] = v;
+                    const openvdb::Index m = FloatLeaf::coordToOffset(c);
+                    layer[u * kDim + v] = beside->isValueOn(m) ? beside->getValue(m) : background_;
                 }
         }
+    in.background = background_, in.lo = lo_, in.scale = 1.f / (hi_ - lo_);  // as gradientOf normalises
+    in.table = &table_;
     in.origin = glm::ivec3(origin.x(), origin.y(), origin.z());
     in.indexToWorld = volume_.indexToWorld;
     in.eye = eye_;

@@ -45,7 +45,8 @@ public:
     /// operator() without classifying it again (which was 7 % of a shaded far view).
     openvdb::Vec3f shadeDrawn(Accessor& acc, const FloatLeaf* leaf, openvdb::Index n, const openvdb::Coord& ijk) const;
     /// @brief Every voxel's factors of @p leaf at once, vectorised (shading/shade_leaf.h): for
-    /// each voxel n the (D, S, G) shadeDrawn gives, bit for bit (active or not: read those drawn).
+    /// each active voxel n the table may draw (its index not below transparentBelow) the (D, S, G)
+    /// shadeDrawn gives, bit for bit; (1, 0, 1), unshaded, for the others.
     /// @return false, writing nothing, where leafShadingSupported() does not hold.
     bool shadeLeaf(Accessor& acc, const FloatLeaf& leaf, LeafFactors& out) const;
 

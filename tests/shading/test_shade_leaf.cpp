@@ -7,6 +7,7 @@
 
 #include <hwy/targets.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -81,19 +82,26 @@ ClassificationTable rampTable() {
 
 bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-/// Every voxel of every leaf: shadeLeaf's factors against shadeDrawn's, bit for bit.
-void expectEveryLeafAsVoxelByVoxel(const Volume& v, const VoxelShader& shader, uint64_t& lit, uint64_t& compared) {
+/// Every voxel of every leaf: shadeLeaf's factors against shadeDrawn's, bit for bit, where the
+/// table may draw the voxel (active, finite, index ≥ transparentBelow), and (1, 0, 1) elsewhere.
+void expectEveryLeafAsVoxelByVoxel(const Volume& v, const ClassificationTable& table, const VoxelShader& shader,
+                                   uint64_t& lit, uint64_t& skipped, uint64_t& compared) {
     VoxelShader::Accessor acc(*v.tree);
     LeafFactors f;
     for (auto leaf = v.tree->cbeginLeaf(); leaf; ++leaf) {
         ASSERT_TRUE(shader.shadeLeaf(acc, *leaf, f));
         for (openvdb::Index n = 0; n < LeafFactors::kVoxels; ++n) {
-            const openvdb::Vec3f want = shader.shadeDrawn(acc, &*leaf, n, leaf->offsetToGlobalCoord(n));
+            const float value = leaf->getValue(n);
+            const float index = std::clamp(value * table.scale() + table.offset(), 0.f, float(ClassificationTable::kSize - 1));
+            const bool drawn = leaf->isValueOn(n) && std::isfinite(value) && !(index < table.transparentBelow());
+            const openvdb::Vec3f want = drawn ? shader.shadeDrawn(acc, &*leaf, n, leaf->offsetToGlobalCoord(n))
+                                              : openvdb::Vec3f(1.f, 0.f, 1.f);
             SCOPED_TRACE(testing::Message() << "leaf " << leaf->origin() << " voxel " << n);
             ASSERT_TRUE(sameBits(f.diffuse[n], want[0])) << f.diffuse[n] << " " << want[0];
             ASSERT_TRUE(sameBits(f.specular[n], want[1])) << f.specular[n] << " " << want[1];
             ASSERT_TRUE(sameBits(f.opacity[n], want[2])) << f.opacity[n] << " " << want[2];
             lit += want[1] > 0.f;
+            skipped += !drawn;
             ++compared;
         }
     }
@@ -110,17 +118,18 @@ TEST(ShadeLeaf, EqualsTheVoxelByVoxelFactorsBitForBit) {
     opacityOnly.gradientOpacity = 40.f;
     const glm::dvec3 onAVoxel(v.indexToWorld * glm::dvec4(2.0, 5.0, 6.0, 1.0));  // the eye exactly at a voxel centre
     const glm::dvec3 eyes[] = {{40.0, -25.0, 60.0}, {3.1, 2.2, 5.7}, onAVoxel};
-    uint64_t lit = 0, compared = 0;
+    uint64_t lit = 0, skipped = 0, compared = 0;
     onBestAndAvx2([&] {
         for (const ShadingSettings& s : {phong, lightAndOpacity, opacityOnly})
             for (const glm::dvec3& eye : eyes)
                 for (const float hi : {1.f, 0.6f}) {  // two normalisations
                     const VoxelShader shader(v, table, 0.f, hi, eye, s);
-                    expectEveryLeafAsVoxelByVoxel(v, shader, lit, compared);
+                    expectEveryLeafAsVoxelByVoxel(v, table, shader, lit, skipped, compared);
                 }
     });
     EXPECT_GT(compared, 100000u);
     EXPECT_GT(lit, compared / 10);  // the specular term is exercised, not just the unshaded lanes
+    EXPECT_GT(skipped, compared / 10);  // and voxels the table leaves transparent
 }
 
 // In the stream, shaded: every record the same with the whole-leaf factors as voxel by voxel, at a
