@@ -5,8 +5,6 @@
 // And in the stream: the same records with the whole-leaf factors as voxel by voxel.
 #include <gtest/gtest.h>
 
-#include <hwy/targets.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -14,30 +12,12 @@
 
 #include "camera/camera.h"
 #include "shading/shading_field.h"
+#include "support/targets.h"
 #include "volume/generate.h"
 #include "volume/stream.h"
 
 namespace vdbsplat {
 namespace {
-
-/// Runs @p body on the best target and, where the CPU has more, on AVX2 (8-float vectors).
-template <typename Body>
-void onBestAndAvx2(Body body) {
-    if (!leafShadingSupported()) GTEST_SKIP() << "this CPU has no 8-float vectors (voxel-by-voxel shading only)";
-    {
-        SCOPED_TRACE("best target");
-        body();
-    }
-#if HWY_ARCH_X86
-    if ((hwy::SupportedTargets() & HWY_AVX2) && hwy::SupportedTargets() != HWY_AVX2) {
-        hwy::SetSupportedTargetsForTest(HWY_AVX2);
-        ASSERT_TRUE(leafShadingSupported());
-        SCOPED_TRACE("AVX2");
-        body();
-        hwy::SetSupportedTargetsForTest(0);  // back to what the CPU has
-    }
-#endif
-}
 
 /// Leaves of random values (some inactive, one NaN, one +∞) around the leaf at the origin, an
 /// active and an inactive tile beside others, and an affine, off-axis index-to-world map.
@@ -118,8 +98,10 @@ TEST(ShadeLeaf, EqualsTheVoxelByVoxelFactorsBitForBit) {
     opacityOnly.gradientOpacity = 40.f;
     const glm::dvec3 onAVoxel(v.indexToWorld * glm::dvec4(2.0, 5.0, 6.0, 1.0));  // the eye exactly at a voxel centre
     const glm::dvec3 eyes[] = {{40.0, -25.0, 60.0}, {3.1, 2.2, 5.7}, onAVoxel};
+    if (!leafShadingSupported()) GTEST_SKIP() << "this CPU has no 8-float vectors (voxel-by-voxel shading only)";
     uint64_t lit = 0, skipped = 0, compared = 0;
-    onBestAndAvx2([&] {
+    test::forEachTarget([&] {  // AVX2 and AVX-512 shade; SSE4 and scalar say they do not
+        if (!leafShadingSupported()) return;
         for (const ShadingSettings& s : {phong, lightAndOpacity, opacityOnly})
             for (const glm::dvec3& eye : eyes)
                 for (const float hi : {1.f, 0.6f}) {  // two normalisations
