@@ -473,8 +473,9 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
     out.withDepthSpread = options_.depthSpread;
     out.resize(first + std::min<size_t>(b.voxels, openvdb::FloatTree::LeafNodeType::SIZE));
     size_t k = first;
-    // A plain leaf (no shading, emission or blend weights): a vector of rows at a time
-    // (volume/leaf_extract.h), the same records as the voxel-by-voxel path below.
+    // A leaf without emission or blend weights (shaded by its factors where shading is on): a
+    // vector of rows at a time (volume/leaf_extract.h), the same records as the voxel-by-voxel
+    // path below.
     LeafFactors factors;  // a shaded leaf's (VoxelShader::shadeLeaf)
     if (!coarse && b.leaf && !emission_ && options_.vectorExtract && table_.entries() && leafExtractSupported() &&
         (!shader_ || shadeWholeLeaf(b, factors))) {
