@@ -47,7 +47,10 @@ SlabProfile slabFractionsOf(const Cdf& cdf, double offset, double unitInSlabs, i
         p.fraction[size_t(reach)] = 1.f;
         return p;
     }
-    for (int j = 0; j <= 2 * reach; ++j) p.fraction[size_t(j)] = float(f[size_t(j)] / sum);
+    // One division: f·(1/sum) in double is within an ulp of f/sum, so the float fractions are the
+    // quotient's but where that ulp straddles a float's rounding boundary (~2⁻²⁸ of them).
+    const double invSum = 1.0 / sum;
+    for (int j = 0; j <= 2 * reach; ++j) p.fraction[size_t(j)] = float(f[size_t(j)] * invSum);
     return p;
 }
 

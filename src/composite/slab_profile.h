@@ -53,11 +53,14 @@ public:
     explicit MarginalCdfTable(const KernelShape& kernel);
     double operator()(double x) const {
         const double u = (x + radius_) * scale_;
-        if (!(u > 0.0)) return 0.0;
-        if (u >= double(kIntervals)) return 1.0;
-        const int i = int(u);
-        const double t = u - double(i);
-        return value_[size_t(i)] + t * (value_[size_t(i) + 1] - value_[size_t(i)]);
+        // Without branches (which tail a slab boundary falls in changes from primitive to
+        // primitive): u ≤ 0 (or NaN) reads interval 0 at t = 0, i.e. C(−R) = 0 exactly, and
+        // u ≥ kIntervals is replaced by 1 at the end.
+        const double v = u > 0.0 && u < double(kIntervals) ? u : 0.0;
+        const int i = int(v);
+        const double t = v - double(i);
+        const double c = value_[size_t(i)] + t * (value_[size_t(i) + 1] - value_[size_t(i)]);
+        return u >= double(kIntervals) ? 1.0 : c;
     }
     static constexpr int kIntervals = 4096;
 
