@@ -63,6 +63,11 @@ public:
         return u >= double(kIntervals) ? 1.0 : c;
     }
     static constexpr int kIntervals = 4096;
+    /// The table as the vector fractions read it (slabFractionsBatch): C at the kIntervals + 1
+    /// points −R + i / scale().
+    double radius() const { return radius_; }
+    double scale() const { return scale_; }
+    const double* values() const { return value_.data(); }
 
 private:
     double radius_, scale_;
@@ -78,6 +83,12 @@ private:
 /// C(x) is kernelMarginalCdf, or the MarginalCdfTable of it (the projection's).
 SlabProfile slabFractions(const KernelShape& kernel, double offset, double unitInSlabs, int reach, int lowest = -kMaxSlabReach);
 SlabProfile slabFractions(const MarginalCdfTable& cdf, double offset, double unitInSlabs, int reach, int lowest = -kMaxSlabReach);
+
+/// @brief What slabFractions(@p cdf, offset[k], unitInSlabs[k], @p reach, lowest[k]) gives, for
+/// k < @p n, into @p out[k]: bit for bit (the same double operations in the same order, a vector
+/// of primitives at a time with Google Highway; composite/slab_fractions.cpp).
+void slabFractionsBatch(const MarginalCdfTable& cdf, const double* offset, const double* unitInSlabs, const int* lowest,
+                        size_t n, int reach, SlabProfile* out);
 
 /// @brief The reach K (slabs on either side) a kernel of radius @p radiusInSlabs slab lengths
 /// needs, at most kMaxSlabReach: ⌈R⌉ (a centre anywhere in its slab).

@@ -241,7 +241,16 @@ Primitive projectVoxel(const glm::dvec3& c, float sigma, const glm::vec3& color,
     return p;
 }
 
-SlabProfile slabProfileFor(const glm::dvec3& c, double distance, int64_t slab, float depthSpread, const ProjectionContext& ctx) {
+namespace {
+
+/// What slabFractions takes of a primitive besides the kernel (slabProfileFor).
+struct SlabProfileInput {
+    double offset = 0.0;       ///< its centre, in slab lengths past the start of its own slab
+    double unitInSlabs = 1.0;  ///< its kernel unit along the ray, in slab lengths
+    int lowest = -kMaxSlabReach;  ///< the first slab it may reach, relative to its own (none before the eye)
+};
+
+SlabProfileInput slabProfileInput(const glm::dvec3& c, double distance, int64_t slab, float depthSpread, const ProjectionContext& ctx) {
     const KernelShape& kernel = *ctx.tables.kernel;
     const double length = glm::length(c);
     const glm::dvec3 omega = length > 0.0 ? c / length : glm::dvec3(0.0, 0.0, 1.0);
@@ -250,10 +259,36 @@ SlabProfile slabProfileFor(const glm::dvec3& c, double distance, int64_t slab, f
     const double unit0 = ctx.shape && !ctx.shape->sphere ? glm::length(glm::transpose(ctx.shape->M) * omega) : ctx.voxelSize;
     const double s = kernel.sigma();
     const double unit = std::sqrt(unit0 * unit0 + double(depthSpread) / (s * s));
-    const double offset = distance / ctx.slabLength - double(slab);
-    const int lowest = int(-std::min<int64_t>(slab, kMaxSlabReach));
-    return ctx.marginal ? slabFractions(*ctx.marginal, offset, unit / ctx.slabLength, ctx.slabs.reach, lowest)
-                        : slabFractions(kernel, offset, unit / ctx.slabLength, ctx.slabs.reach, lowest);
+    return {distance / ctx.slabLength - double(slab), unit / ctx.slabLength, int(-std::min<int64_t>(slab, kMaxSlabReach))};
+}
+
+/// The slab profiles of up to kSplatLanes primitives of a projection chunk, computed together
+/// (slabFractionsBatch: the same fractions as slabProfileFor's, a vector of primitives at a time)
+/// and then stored into their window.
+struct PendingProfiles {
+    std::array<double, kSplatLanes> offset, unitInSlabs;
+    std::array<int, kSplatLanes> lowest;
+    std::array<size_t, kSplatLanes> index;
+    std::array<SlabProfile, kSplatLanes> profile;
+    size_t count = 0;
+
+    void add(size_t i, const SlabProfileInput& in) {
+        offset[count] = in.offset, unitInSlabs[count] = in.unitInSlabs, lowest[count] = in.lowest, index[count] = i;
+        ++count;
+    }
+    void flush(const MarginalCdfTable& cdf, int reach, ProjectedWindow& window) {
+        slabFractionsBatch(cdf, offset.data(), unitInSlabs.data(), lowest.data(), count, reach, profile.data());
+        for (size_t k = 0; k < count; ++k) window.profile[index[k]] = profile[k];
+        count = 0;
+    }
+};
+
+}  // namespace
+
+SlabProfile slabProfileFor(const glm::dvec3& c, double distance, int64_t slab, float depthSpread, const ProjectionContext& ctx) {
+    const SlabProfileInput in = slabProfileInput(c, distance, slab, depthSpread, ctx);
+    return ctx.marginal ? slabFractions(*ctx.marginal, in.offset, in.unitInSlabs, ctx.slabs.reach, in.lowest)
+                        : slabFractions(*ctx.tables.kernel, in.offset, in.unitInSlabs, ctx.slabs.reach, in.lowest);
 }
 
 std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx) {
@@ -290,9 +325,11 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
             SplatLanes lanes;
             PointLanes points;
             std::array<int64_t, kSplatLanes> slabs;  // of voxels [chunk, chunkEnd)
+            PendingProfiles profiles;                // --compositing slabs: the chunk's, in vectors
             size_t chunk = r.begin(), chunkEnd = r.begin();  // the voxels of the current chunk
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 if (i == chunkEnd) {  // the next kSplatLanes voxels: their slabs, and their splats projected at once
+                    if (profiles.count > 0) profiles.flush(*ctx.marginal, ctx.slabs.reach, window);
                     chunk = i, chunkEnd = std::min(r.end(), i + kSplatLanes);
                     slabsOf(batch.distance.data() + chunk, chunkEnd - chunk, ctx.slabLength, batch.slabBegin,
                             batch.slabEnd - 1, slabs.data());
@@ -315,9 +352,14 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                     kind = p.kind, range = p.range;
                 }
                 if (kind == PrimitiveKind::Culled) continue;
-                if (ctx.slabs.on)
-                    window.profile[i] = slabProfileFor(glm::dvec3(batch.viewPos[i]), batch.distance[i], slab,
-                                                       batch.depthSpread.empty() ? 0.f : batch.depthSpread[i], ctx);
+                if (ctx.slabs.on) {
+                    const glm::dvec3 c(batch.viewPos[i]);
+                    const float depthSpread = batch.depthSpread.empty() ? 0.f : batch.depthSpread[i];
+                    if (ctx.vector && ctx.marginal)
+                        profiles.add(i, slabProfileInput(c, batch.distance[i], slab, depthSpread, ctx));
+                    else
+                        window.profile[i] = slabProfileFor(c, batch.distance[i], slab, depthSpread, ctx);
+                }
                 const uint32_t members = batch.members[i];
                 ++(kind == PrimitiveKind::Point ? c.points : c.splats);
                 if (kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
@@ -330,6 +372,7 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                     c.hidden.voxels += members;
                 }
             }
+            if (profiles.count > 0) profiles.flush(*ctx.marginal, ctx.slabs.reach, window);
             return c;
         },
         [](ProjectionCounts a, const ProjectionCounts& b) { return a += b; });

@@ -2,12 +2,16 @@
 // (composite/slab_profile.h) against brute-force integration of the kernel along rays.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <random>
+#include <vector>
 
 #include "composite/slab_profile.h"
 #include "footprint/kernel.h"
+#include "support/targets.h"
 
 namespace vdbsplat {
 namespace {
@@ -154,6 +158,44 @@ TEST(SlabProfile, FractionsSumToOne) {
         }
         EXPECT_NEAR(sum, 1.f, 4e-7f) << offset << " " << unit << " " << reach;
     }
+}
+
+// The projection's vector fractions (slabFractionsBatch) are the scalar slabFractions' bit for
+// bit, on every SIMD target the binary holds: centres in and outside their slab, units from
+// a tenth of a slab (narrower than 1e−12, and 0 and NaN: the scalar's std::max) to wide aggregates,
+// every reach, cuts at the eye, batch lengths that leave a partial last vector, and a centre so far
+// out that nothing is within reach (all in its own slab).
+TEST(SlabProfile, BatchEqualsTheScalarFractionsBitForBit) {
+    test::forEachTarget([] {
+        for (const KernelShape* k : {&KernelShape::standard(), &KernelShape::sharp()}) {
+            const MarginalCdfTable table(*k);
+            std::mt19937 rng(11);
+            std::uniform_real_distribution<double> u(0.0, 1.0);
+            for (int reach = 0; reach <= kMaxSlabReach; ++reach)
+                for (const size_t n : {size_t(1), size_t(7), size_t(64)}) {
+                    std::vector<double> offset(n), unit(n);
+                    std::vector<int> lowest(n);
+                    for (size_t i = 0; i < n; ++i) {
+                        offset[i] = -0.3 + 1.6 * u(rng);
+                        unit[i] = 0.1 + 6.0 * u(rng);
+                        lowest[i] = u(rng) < 0.3 ? -int(u(rng) * (reach + 1)) : -kMaxSlabReach;
+                    }
+                    offset[0] = 0.5;  // an exact slab centre
+                    if (n > 2) offset[1] = 40.0, unit[2] = 0.0;  // nothing within reach; a zero unit
+                    if (n > 4) unit[3] = std::nan(""), unit[4] = 1e-13;
+                    std::vector<SlabProfile> batch(n);
+                    slabFractionsBatch(table, offset.data(), unit.data(), lowest.data(), n, reach, batch.data());
+                    for (size_t i = 0; i < n; ++i) {
+                        const SlabProfile scalar = slabFractions(table, offset[i], unit[i], reach, lowest[i]);
+                        for (int j = 0; j < kMaxSlabSpan; ++j)
+                            ASSERT_EQ(std::bit_cast<uint32_t>(batch[i].fraction[size_t(j)]),
+                                      std::bit_cast<uint32_t>(scalar.fraction[size_t(j)]))
+                                << k->id() << " reach " << reach << " i " << i << " slab " << j << ": offset " << offset[i]
+                                << " unit " << unit[i] << " lowest " << lowest[i];
+                    }
+                }
+        }
+    });
 }
 
 }  // namespace
