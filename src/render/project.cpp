@@ -276,8 +276,10 @@ struct PendingProfiles {
         offset[count] = in.offset, unitInSlabs[count] = in.unitInSlabs, lowest[count] = in.lowest, index[count] = i;
         ++count;
     }
-    void flush(const MarginalCdfTable& cdf, int reach, ProjectedWindow& window) {
-        slabFractionsBatch(cdf, offset.data(), unitInSlabs.data(), lowest.data(), count, reach, profile.data());
+    /// Computes the pending profiles into their window; nothing when none is pending.
+    void flush(const MarginalCdfTable* cdf, int reach, ProjectedWindow& window) {
+        if (count == 0) return;
+        slabFractionsBatch(*cdf, offset.data(), unitInSlabs.data(), lowest.data(), count, reach, profile.data());
         for (size_t k = 0; k < count; ++k) window.profile[index[k]] = profile[k];
         count = 0;
     }
@@ -329,7 +331,7 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
             size_t chunk = r.begin(), chunkEnd = r.begin();  // the voxels of the current chunk
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 if (i == chunkEnd) {  // the next kSplatLanes voxels: their slabs, and their splats projected at once
-                    if (profiles.count > 0) profiles.flush(*ctx.marginal, ctx.slabs.reach, window);
+                    profiles.flush(ctx.marginal, ctx.slabs.reach, window);
                     chunk = i, chunkEnd = std::min(r.end(), i + kSplatLanes);
                     slabsOf(batch.distance.data() + chunk, chunkEnd - chunk, ctx.slabLength, batch.slabBegin,
                             batch.slabEnd - 1, slabs.data());
@@ -352,6 +354,18 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                     kind = p.kind, range = p.range;
                 }
                 if (kind == PrimitiveKind::Culled) continue;
+                const uint32_t members = batch.members[i];
+                ++(kind == PrimitiveKind::Point ? c.points : c.splats);
+                if (kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
+                c.drawnVoxels += members;
+                if (members > 1) ++c.lodAggregates, c.lodVoxels += members;
+                if (ctx.occlusion && !range.empty() && ctx.occlusion->hidden(range.x0, range.y0, range.x1, range.y1)) {
+                    window.order[i] = ProjectedWindow::kNotDrawn;  // never binned: its profile is never read
+                    ++(kind == PrimitiveKind::Point ? c.hidden.points : c.hidden.splats);
+                    if (kind == PrimitiveKind::SplatExactIndex) ++c.hidden.exactIndexSplats;
+                    c.hidden.voxels += members;
+                    continue;
+                }
                 if (ctx.slabs.on) {
                     const glm::dvec3 c(batch.viewPos[i]);
                     const float depthSpread = batch.depthSpread.empty() ? 0.f : batch.depthSpread[i];
@@ -360,19 +374,8 @@ ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& 
                     else
                         window.profile[i] = slabProfileFor(c, batch.distance[i], slab, depthSpread, ctx);
                 }
-                const uint32_t members = batch.members[i];
-                ++(kind == PrimitiveKind::Point ? c.points : c.splats);
-                if (kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
-                c.drawnVoxels += members;
-                if (members > 1) ++c.lodAggregates, c.lodVoxels += members;
-                if (ctx.occlusion && !range.empty() && ctx.occlusion->hidden(range.x0, range.y0, range.x1, range.y1)) {
-                    window.order[i] = ProjectedWindow::kNotDrawn;
-                    ++(kind == PrimitiveKind::Point ? c.hidden.points : c.hidden.splats);
-                    if (kind == PrimitiveKind::SplatExactIndex) ++c.hidden.exactIndexSplats;
-                    c.hidden.voxels += members;
-                }
             }
-            if (profiles.count > 0) profiles.flush(*ctx.marginal, ctx.slabs.reach, window);
+            profiles.flush(ctx.marginal, ctx.slabs.reach, window);
             return c;
         },
         [](ProjectionCounts a, const ProjectionCounts& b) { return a += b; });
