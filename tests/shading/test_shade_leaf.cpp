@@ -151,7 +151,9 @@ TEST(ShadeLeaf, StreamRecordsEqualTheVoxelByVoxelShading) {
         ASSERT_EQ(vectorised.size(), scalar.size());
         for (size_t i = 0; i < scalar.size(); ++i)
             ASSERT_NEAR(vectorised[i], scalar[i], 1e-5f * std::max(1.f, std::abs(scalar[i]))) << "number " << i;
-        if (distance > 4.0) EXPECT_GT(aggregates, 1000u);  // the far view's records are cells
+        if (distance > 4.0) {
+            EXPECT_GT(aggregates, 1000u);  // the far view's records are cells
+        }
     }
 }
 
