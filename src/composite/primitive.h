@@ -145,21 +145,22 @@ struct ProjectedWindow {
         q.range = p.range;
         q.kind = p.kind;
         q.hasExactMap = p.hasExactMap;
-        place(i, p.slab, p.depth, p.members);
+        place(i, p.slab, p.depth, p.members, p.kind, p.range);
         if (needsExtra(p.kind)) extra[i] = PrimitiveExtra{p.exactMap, p.viewPos, p.sigma};
         if (profiles) profile[i] = p.profile;
     }
     /// The rest of primitive @p i once records[i] holds all but its slab (set() does this; the
     /// projection's lane path writes its splats' records in place and then calls this, without
     /// building a Primitive: a record built aside and copied stalled on store forwarding):
-    /// its slab @p absoluteSlab, its order key, @p distance and @p voxels.
-    void place(size_t i, int64_t absoluteSlab, float distance, uint32_t voxels) {
-        PrimitiveRecord& q = records[i];
+    /// its slab @p absoluteSlab, its order key, @p distance and @p voxels. @p kind and @p range
+    /// are the record's, passed in: read back from the record just stored, they waited on its
+    /// store (docs/performance.md, session 38).
+    void place(size_t i, int64_t absoluteSlab, float distance, uint32_t voxels, PrimitiveKind kind, const PixelRange& range) {
         const uint32_t slab = uint32_t(std::clamp<int64_t>(absoluteSlab - slabBase, 0, kMaxRelativeSlab));
-        q.slab = slab;
-        const bool drawn = q.kind != PrimitiveKind::Culled && !q.range.empty();
-        order[i] = drawn ? slab << 1 | (q.kind == PrimitiveKind::Point ? 0u : 1u) : kNotDrawn;
-        if (drawn) tiles[i] = tileRect(q.range);
+        records[i].slab = slab;
+        const bool drawn = kind != PrimitiveKind::Culled && !range.empty();
+        order[i] = drawn ? slab << 1 | (kind == PrimitiveKind::Point ? 0u : 1u) : kNotDrawn;
+        if (drawn) tiles[i] = tileRect(range);
         depth[i] = distance;
         members[i] = voxels;
     }

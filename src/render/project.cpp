@@ -157,7 +157,7 @@ PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const 
     q.sin2Alpha = float(lanes.sinAlpha[k] * lanes.sinAlpha[k]);
     q.color = ctx.showPrimitives ? splatTint(batch.color[i]) : batch.color[i];
     q.range = range = lanes.range(k);
-    window.place(i, slab, batch.distance[i], batch.members[i]);
+    window.place(i, slab, batch.distance[i], batch.members[i], kind, range);
     if (kind == PrimitiveKind::SplatExactIndex) {  // in place (SplatLanes::exactMapInto)
         PrimitiveExtra& extra = window.extra[i];
         lanes.exactMapInto(k, extra.exactMap);
@@ -179,7 +179,7 @@ void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const VoxelBatc
     q.sin2Alpha = 0.f;
     q.color = batch.color[i];  // points are never tinted
     q.range = range = lanes.range(k, ctx.camera.width(), ctx.camera.height());
-    window.place(i, slab, batch.distance[i], batch.members[i]);
+    window.place(i, slab, batch.distance[i], batch.members[i], PrimitiveKind::Point, range);
 }
 
 /// Voxels [@p first, @p first + @p n) of @p batch (n ≤ kSplatLanes) into the lanes, and projected
