@@ -5,7 +5,6 @@
 #include <hwy/foreach_target.h>  // must come before highway.h
 #include <hwy/highway.h>
 
-#include <cstring>
 
 #include "volume/classify-inl.h"
 #include "volume/leaf_extract.h"
@@ -43,7 +42,7 @@ size_t ExtractRows(D d, const float* values, const uint64_t* maskWords, const Cl
         }
         const auto toFloat = [&](VD lo, VD hi) { return hn::Combine(d, hn::DemoteTo(dh, hi), hn::DemoteTo(dh, lo)); };
         const V zero = hn::Zero(d);
-        alignas(64) float staged[3 * 16];
+        static_assert(hn::MaxLanes(D()) <= kLeafRecordSlack, "a vector of records fits the slack");
         size_t k = 0;
         for (int x = 0; x < 8; ++x) {
             const double X = double(origin.x) + double(x);
@@ -66,14 +65,16 @@ size_t ExtractRows(D d, const float* values, const uint64_t* maskWords, const Cl
                     dist[h] = hn::Sqrt(hn::Add(hn::Add(hn::Mul(p[h][0], p[h][0]), hn::Mul(p[h][1], p[h][1])), hn::Mul(p[h][2], p[h][2])));
                 }
                 const size_t count = hn::CountTrue(d, keep);
+                // The kept lanes first, stored whole: the lanes past `count` land in the records
+                // the next vector overwrites, or in the slack (kLeafRecordSlack). Staged aside and
+                // copied by their count, the copy was a `rep movsq` per array and vector, ~40 % of
+                // this loop (docs/performance.md, session 38).
                 const auto stage3 = [&](V a, V b, V c, glm::vec3* to) {
-                    hn::StoreInterleaved3(hn::Compress(a, keep), hn::Compress(b, keep), hn::Compress(c, keep), d, staged);
-                    std::memcpy(to + k, staged, count * sizeof(glm::vec3));
+                    static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "vec3 is three packed floats");
+                    hn::StoreInterleaved3(hn::Compress(a, keep), hn::Compress(b, keep), hn::Compress(c, keep), d,
+                                          reinterpret_cast<float*>(to + k));
                 };
-                const auto stage1 = [&](V a, float* to) {
-                    hn::Store(hn::Compress(a, keep), d, staged);
-                    std::memcpy(to + k, staged, count * sizeof(float));
-                };
+                const auto stage1 = [&](V a, float* to) { hn::StoreU(hn::Compress(a, keep), d, to + k); };
                 stage3(toFloat(p[0][0], p[1][0]), toFloat(p[0][1], p[1][1]), toFloat(p[0][2], p[1][2]), out.viewPos);
                 stage1(toFloat(dist[0], dist[1]), out.distance);
                 stage1(sigma, out.sigma);

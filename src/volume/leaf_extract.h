@@ -16,7 +16,12 @@
 
 namespace vdbsplat {
 
-/// @brief Arrays with room for 512 records each (a whole leaf).
+/// @brief Room past a leaf's records that extractLeafVoxels may write (and leave undefined): a
+/// vector of records is stored whole, however few of its lanes are kept.
+inline constexpr size_t kLeafRecordSlack = 16;
+
+/// @brief Arrays with room for the leaf's active voxels plus kLeafRecordSlack records each (or
+/// for 512: a vector never ends past the leaf's voxels).
 struct LeafRecords {
     glm::vec3* viewPos;
     float* distance;
@@ -29,7 +34,8 @@ bool leafExtractSupported();
 
 /// @brief Writes the records of the leaf at index @p origin (its first voxel) whose @p values are in
 /// OpenVDB's order (n = x·64 + y·8 + z) and @p maskWords its 8 value-mask words (nullptr: dense),
-/// through @p indexToView; returns how many. With @p factors, each voxel is shaded as applyShading
+/// through @p indexToView; returns how many. It may write up to kLeafRecordSlack records past them
+/// (the caller cuts them off). With @p factors, each voxel is shaded as applyShading
 /// does (c·D + S, σ·G) before the σ > 0 test. @p table must not be empty(); leafExtractSupported()
 /// must hold.
 size_t extractLeafVoxels(const float* values, const uint64_t* maskWords, const ClassificationTable& table,

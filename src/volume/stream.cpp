@@ -471,7 +471,8 @@ void VoxelStream::extractVoxels(const Block& b, const float* coarse, VoxelBatch&
     // check per voxel here cost the stream 60 %: 32 → 53 ms on the framed Engine).
     const size_t first = out.size();
     out.withDepthSpread = options_.depthSpread;
-    out.resize(first + std::min<size_t>(b.voxels, openvdb::FloatTree::LeafNodeType::SIZE));
+    // (kLeafRecordSlack: the vector path may store records past its last, cut off below.)
+    out.resize(first + std::min<size_t>(b.voxels, openvdb::FloatTree::LeafNodeType::SIZE) + kLeafRecordSlack);
     size_t k = first;
     // A leaf without emission or blend weights (shaded by its factors where shading is on): a
     // vector of rows at a time (volume/leaf_extract.h), the same records as the voxel-by-voxel
@@ -900,6 +901,7 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
                 // reallocated and copied up to five times per chunk, each time into fresh pages.
                 size_t expected = 0;
                 for (size_t j = c * kExtractChunk; j < chunkEnd; ++j) expected += recordsOf(block(first + j));
+                expected += kLeafRecordSlack;  // the last leaf's vectors may write past its records
                 if (e.viewPos.capacity() < expected) e.reserve(expected, options_.depthSpread);
                 for (size_t j = c * kExtractChunk; j < chunkEnd; ++j) {
                     const size_t i = first + j;
