@@ -5,7 +5,6 @@
 #include <hwy/foreach_target.h>  // must come before highway.h
 #include <hwy/highway.h>
 
-
 #include "volume/classify-inl.h"
 #include "volume/leaf_extract.h"
 
