@@ -68,6 +68,16 @@ inline constexpr std::array<float, kDegree + 1> kPow2 = [] {
     }
     return c;
 }();
+/// @brief 2^f for f ∈ [−½, ½]: the polynomial by Estrin's scheme, f² and f⁴ beside the pairs
+/// c_k + c_{k+1}·f, so its longest chain is 5 operations where Horner's is 12 (the far views'
+/// point loop waited on it, docs/performance.md, session 38). Every step one float product or
+/// sum, in this order: the vector form (point_weight-inl.h) repeats it operation for operation.
+inline float pow2Fraction(float f) {
+    static_assert(kDegree == 6, "Estrin's pairs below are written for degree 6");
+    const float f2 = f * f, f4 = f2 * f2;
+    const float a = kPow2[0] + kPow2[1] * f, b = kPow2[2] + kPow2[3] * f, c = kPow2[4] + kPow2[5] * f;
+    return (a + f2 * b) + f4 * (c + f2 * kPow2[6]);
+}
 /// @brief Max |pointFilterWeight − exp(−x/2)| over 16 384 samples of [0, kMaxX).
 double maxAbsError();
 }  // namespace point_filter_weight
@@ -75,7 +85,7 @@ double maxAbsError();
 /// @brief The point filter's Gaussian weight exp(−x/2) at x = r²/V ∈ [0, kPointSupportSigmas²);
 /// 0 for x ≥ point_filter_weight::kMaxX or NaN. A pure function: nothing to set up or pass.
 /// No table and no gather: exp(−x/2) = 2^y with y = x·(−log₂e/2), split into n = round(y) and
-/// f = y − n ∈ [−½, ½], so 2^y = 2^n·2^f, with 2^f its Taylor polynomial to degree 6 (Horner) and
+/// f = y − n ∈ [−½, ½], so 2^y = 2^n·2^f, with 2^f its Taylor polynomial to degree 6 (Estrin) and
 /// 2^n an exact power of two. Every step is one float product or sum (no fused multiply-add), so
 /// the scalar pointFilterWeight() and the vector one (point_weight-inl.h) give the same floats on
 /// every SIMD target. Error: the series' remainder (ln 2/2)⁷/7!·2^½ < 1.7e−7 of 2^f, plus a few
@@ -90,11 +100,7 @@ inline float pointFilterWeight(float x) {
     const float y = (x > 0.0f ? x : 0.0f) * pfw::kYPerX;
     const float n = std::nearbyint(y);  // round half to even, as the vector Round
     const float f = y - n;
-    float p = pfw::kPow2[pfw::kDegree];
-    for (int k = pfw::kDegree - 1; k >= 0; --k) {
-        const float pf = p * f;
-        p = pf + pfw::kPow2[size_t(k)];
-    }
+    const float p = pfw::pow2Fraction(f);
     return p * std::bit_cast<float>((static_cast<int>(n) + 127) << 23);
 }
 

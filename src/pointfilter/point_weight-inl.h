@@ -31,8 +31,12 @@ HWY_INLINE V PointWeight(D d, V x) {
     const V y = hn::Mul(hn::Max(hn::IfThenElseZero(valid, x), hn::Zero(d)), hn::Set(d, pfw::kYPerX));
     const V n = hn::Round(y);
     const V f = hn::Sub(y, n);
-    V p = hn::Set(d, pfw::kPow2[kDegree]);
-    for (int k = kDegree - 1; k >= 0; --k) p = hn::Add(hn::Mul(p, f), hn::Set(d, pfw::kPow2[size_t(k)]));
+    // pfw::pow2Fraction's operations, in its order (Estrin's scheme).
+    static_assert(kDegree == 6, "pow2Fraction's degree");
+    const auto c = [&](int k) { return hn::Set(d, pfw::kPow2[size_t(k)]); };
+    const V f2 = hn::Mul(f, f), f4 = hn::Mul(f2, f2);
+    const V a = hn::Add(c(0), hn::Mul(c(1), f)), b = hn::Add(c(2), hn::Mul(c(3), f)), e = hn::Add(c(4), hn::Mul(c(5), f));
+    const V p = hn::Add(hn::Add(a, hn::Mul(f2, b)), hn::Mul(f4, hn::Add(e, hn::Mul(f2, c(6)))));
     const V scale = hn::BitCast(d, hn::ShiftLeft<23>(hn::Add(hn::ConvertTo(di, n), hn::Set(di, 127))));
     return hn::IfThenElseZero(valid, hn::Mul(p, scale));
 }
