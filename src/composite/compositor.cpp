@@ -455,7 +455,7 @@ void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t i, TilePixels& 
 /// slab order, their profiles) 8 ahead, and an exact-index splat's map (two lines) 4 ahead, once
 /// its record has arrived.
 inline void TileCompositor::prefetchAhead(std::span<const Entry> entries, size_t e, bool profiles) const {
-    constexpr size_t kAhead = 8, kMapAhead = 4;
+    constexpr size_t kAhead = 16, kMapAhead = 8;
     // The prefetches are written out here, not in a helper lambda: GCC compiled the lambda out of
     // line, found it free of side effects and dropped its calls, as it did this whole function.
     if (e + kAhead < entries.size()) {
