@@ -91,6 +91,11 @@ constexpr RenderFlag kRenderFlags[] = {
      "depth slab thickness in voxels, 0.5..1 (default: 1 in the kernels\n"
      "order, 0.5 in the slabs order): points are summed per slab, and the\n"
      "slabs order composites once per slab"},
+    {"--cutoff", "T", kQuality,
+     "early termination: a pixel whose transmittance falls below T takes\n"
+     "nothing more, 1e-6..0.05 (default 1e-4, the reference's); what it drops\n"
+     "is at most T times the brightest colour behind (VTK's CPU ray caster\n"
+     "stops at 0.0078; docs/performance.md)"},
     {"--simd", "on|off", kQuality, "splats through the vector loop (default on) or the scalar table path"},
     {"--show-primitives", nullptr, kQuality, "tint splats red, points keep their colour"},
     {"--tables", "DIR", kQuality,
@@ -211,6 +216,7 @@ RenderSettings settingsFromFlags(const Args& args) {
     if (auto v = args.get("--threads")) s.threads = int(parseInt(*v, "--threads", 0, 1024));
     if (auto v = args.get("--spp")) s.spp = int(parseInt(*v, "--spp", 1, 1024));
     if (auto v = args.get("--threshold")) s.threshold = parseDouble(*v, "--threshold");
+    if (auto v = args.get("--cutoff")) s.cutoff = parseDouble(*v, "--cutoff");
     if (auto v = args.get("--max-voxels"))
         s.maxActiveVoxels = uint64_t(parseInt(*v, "--max-voxels", 1, (long long)kHardMaxActiveVoxels));
     if (auto v = args.get("--footprint")) s.footprint = parseFootprintPath(*v);

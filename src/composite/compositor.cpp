@@ -144,9 +144,9 @@ struct TileCompositor::SlabRing {
 };
 
 TileCompositor::TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs,
-                               CompositorBuffers* buffers, ColorChannels channels)
+                               CompositorBuffers* buffers, ColorChannels channels, float cutoff)
     : width_(width), height_(height), tilesX_((width + kTileSize - 1) / kTileSize),
-      tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact), slabs_(slabs),
+      tilesY_((height + kTileSize - 1) / kTileSize), tables_(tables), exact_(exact), slabs_(slabs), epsilon_(cutoff),
       grey_(channels == ColorChannels::Grey && exact.vector),
       own_(buffers ? nullptr : std::make_unique<CompositorBuffers>()), kept_(buffers ? *buffers : *own_),
       color_(kept_.color), transmittance_(kept_.transmittance), liveCount_(size_t(tilesX_) * tilesY_),
@@ -333,6 +333,7 @@ SkippedPrimitives TileCompositor::binWindow(const ProjectedWindow& window) {
 /// Structure of arrays (T, R, G, B), 64-byte aligned, so the splat loop loads whole rows.
 struct TileCompositor::TilePixels {
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  // inclusive image rectangle of the tile
+    float epsilon = kTransmittanceEpsilon;  // the compositor's cutoff (loadTile sets it)
     alignas(64) std::array<float, kTileSize * kTileSize> T;
     alignas(64) std::array<float, kTileSize * kTileSize> R;
     alignas(64) std::array<float, kTileSize * kTileSize> G;
@@ -344,14 +345,14 @@ struct TileCompositor::TilePixels {
 
     static int local(int x, int y, int x0, int y0) { return (y - y0) * kTileSize + (x - x0); }
     int local(int x, int y) const { return local(x, y, x0, y0); }
-    bool live(int i) const { return T[size_t(i)] >= kTransmittanceEpsilon; }
+    bool live(int i) const { return T[size_t(i)] >= epsilon; }
     /// Whether any pixel has T ≥ ε, 16 pixels at a time (a live tile answers in its first 16:
     /// tile-level early termination asks every 32 primitives, and counting all 1 024 pixels each
     /// time was 70 % of compositeTile's own samples on the framed Engine).
     bool anyLive() const {
         for (size_t i = 0; i < T.size(); i += 16) {
             bool any = false;
-            for (size_t j = 0; j < 16; ++j) any |= T[i + j] >= kTransmittanceEpsilon;
+            for (size_t j = 0; j < 16; ++j) any |= T[i + j] >= epsilon;
             if (any) return true;
         }
         return false;
@@ -381,6 +382,7 @@ bool TileCompositor::hiddenTiles(int x0, int y0, int x1, int y1) const {
 
 void TileCompositor::loadTile(int tile, TilePixels& px) const {
     px.x0 = (tile % tilesX_) * kTileSize, px.y0 = (tile / tilesX_) * kTileSize;
+    px.epsilon = epsilon_;
     px.x1 = std::min(width_, px.x0 + kTileSize) - 1, px.y1 = std::min(height_, px.y0 + kTileSize) - 1;
     px.T.fill(0.f);  // pixels past the image's edge: finished (T = 0), never drawn
     px.R.fill(0.f), px.G.fill(0.f), px.B.fill(0.f);
@@ -408,7 +410,7 @@ void TileCompositor::storeTile(int tile, const TilePixels& px) {
     for (int y = px.y0; y <= px.y1; ++y) {
         const float* row = px.T.data() + size_t(y - px.y0) * kTileSize;
         uint32_t bits = 0;
-        for (int j = 0; j < kTileSize; ++j) bits |= uint32_t(row[j] >= kTransmittanceEpsilon) << j;
+        for (int j = 0; j < kTileSize; ++j) bits |= uint32_t(row[j] >= epsilon_) << j;
         liveRows_[size_t(y) * size_t(tilesX_) + tx] = bits;
         live += std::popcount(bits);
     }
@@ -541,7 +543,7 @@ void TileCompositor::closeSlab(TilePixels& px, SlabBuffer& slab, bool skipFinish
     }
     // The vector loop skips finished pixels too: in the kernel order there are none among a
     // slab's deposits (its points drew only live pixels, and nothing drew in between).
-    compositeSlabVector(slab.tau(), slab.er(), slab.eg(), slab.eb(), px.buffers(grey_), kTransmittanceEpsilon,
+    compositeSlabVector(slab.tau(), slab.er(), slab.eg(), slab.eb(), px.buffers(grey_), epsilon_,
                         slab.take(px.x0, px.y0, px.x1, px.y1));
     slab.dirty = false;
 }
@@ -571,7 +573,7 @@ void TileCompositor::drawPoint(const TileRecord& p, const TilePixels& px, SlabBu
     r.color = p.color;
     r.x0 = std::max(p.range.x0, px.x0), r.x1 = std::min(p.range.x1, px.x1);
     r.y0 = std::max(p.range.y0, px.y0), r.y1 = std::min(p.range.y1, px.y1);
-    r.epsilon = kTransmittanceEpsilon;
+    r.epsilon = epsilon_;
     if (slabs) {
         exact_.vector ? drawPointSlabsVector(r, *slabs, px.T.data(), px.x0, px.y0)
                       : drawPointSlabsScalar(r, *slabs, px.T.data(), px.x0, px.y0);
@@ -617,7 +619,7 @@ void TileCompositor::drawSplat(const TileRecord& p, const ExactIndexMap& map, Ti
         s.color = p.color;
         s.x0 = std::max(p.range.x0, px.x0), s.x1 = std::min(p.range.x1, px.x1);
         s.y0 = std::max(p.range.y0, px.y0), s.y1 = std::min(p.range.y1, px.y1);
-        s.epsilon = kTransmittanceEpsilon;
+        s.epsilon = epsilon_;
         s.slabs = slabs;
         drawSplatVector(s, px.buffers(grey_));
         return;

@@ -36,7 +36,8 @@
 
 namespace vdbsplat {
 
-/// Transmittance below which a pixel is finished (early termination).
+/// Transmittance below which a pixel is finished (early termination), by default: the reference's
+/// (render/reference.h). A render may raise it (RenderSettings::cutoff, --cutoff).
 inline constexpr float kTransmittanceEpsilon = 1e-4f;
 
 /// @brief What the exact and near-eye paths need to recompute a kernel per tile.
@@ -81,8 +82,10 @@ public:
     /// @param buffers where the large buffers live (kept by the caller across renders); null: its own.
     /// @param channels Grey: every primitive's colour is grey (ColorChannels); taken with the vector
     /// loops, else (the scalar oracle) the compositor carries all three.
+    /// @param cutoff ε: a pixel whose transmittance falls below it takes nothing more (> 0).
     TileCompositor(int width, int height, const Tables& tables, const ExactContext& exact, SlabCompositing slabs = {},
-                   CompositorBuffers* buffers = nullptr, ColorChannels channels = ColorChannels::Rgb);
+                   CompositorBuffers* buffers = nullptr, ColorChannels channels = ColorChannels::Rgb,
+                   float cutoff = kTransmittanceEpsilon);
     ~TileCompositor();
 
     /// @brief Composites @p window (one depth window, any order) behind everything before.
@@ -177,6 +180,7 @@ private:
     const Tables& tables_;
     ExactContext exact_;
     SlabCompositing slabs_;
+    float epsilon_;  // the cutoff ε: T < ε is finished
     bool grey_;  // ColorChannels::Grey taken: the vector loops composite T and R, storeTile copies R to G and B
     std::vector<std::unique_ptr<SlabRing>> rings_;  // --compositing slabs: per tile, null while none is open
     template <class T>

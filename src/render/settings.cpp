@@ -51,6 +51,8 @@ void RenderSettings::validate() const {
     if (threads < 0 || threads > 1024) throw Error("--threads: must be in [0, 1024]");
     if (spp < 1 || spp > 1024) throw Error("--spp: must be in [1, 1024]");
     if (!(std::isfinite(threshold) && threshold > 0.0)) throw Error("--threshold: must be a positive number of pixels");
+    if (!(cutoff >= 1e-6 && cutoff <= kMaxCutoff))
+        throw Error("--cutoff: must be a transmittance in [1e-6, 0.05]");
     if (!(std::isfinite(lodPx) && lodPx >= 0.0 && lodPx <= 64.0))
         throw Error("--lod: must be a number of pixels in [0, 64] (0 turns level of detail off)");
     if ((subpixels < 1 && subpixels != kAutoSubpixels) || subpixels > kMaxSubpixels)
@@ -136,6 +138,7 @@ nlohmann::json RenderSettings::toJson() const {
     j["grid"] = gridName;
     j["spp"] = spp;
     j["threshold"] = threshold;
+    if (cutoff != kDefaultCutoff && mode != RenderMode::Reference) j["cutoff"] = cutoff;  // absent at the default: outputs unchanged
     j["footprint"] = toString(footprint);
     j["kernel"] = kernel;
     // Ewa and Swan filter each primitive, None filters nothing (RenderMode): echo what was used.

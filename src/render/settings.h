@@ -18,6 +18,12 @@
 
 namespace vdbsplat {
 
+/// The forward modes' default early-termination transmittance: the reference's (render/reference.h
+/// kReferenceEpsilon, composite/compositor.h kTransmittanceEpsilon).
+inline constexpr double kDefaultCutoff = 1e-4;
+/// The largest --cutoff: what a pixel may drop is at most this much of the brightest colour.
+inline constexpr double kMaxCutoff = 0.05;  // (settings.cpp names it in its error)
+
 /// Reference: the ray integrator (ground truth). Hybrid, Splat, Point: Yuan et al. 2003 with the
 /// EWA low-pass on the exact perspective ellipse. The study modes (DESIGN §6, docs/modes.md):
 ///   Ewa  — Zwicker et al. 2001: every voxel a splat from the local affine approximation of the
@@ -98,6 +104,10 @@ struct RenderSettings {
     int threads = 0;                        ///< 0: all cores
     int spp = 16;                           ///< reference: rays per pixel (rounded to a square)
     double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
+    /// ε, early termination (--cutoff): a pixel whose transmittance falls below it takes nothing
+    /// more, and blocks and primitives behind such pixels are skipped. What it drops is at most
+    /// ε·(the brightest colour behind) per pixel; the default is the reference's (kDefaultCutoff).
+    double cutoff = kDefaultCutoff;
     FootprintPath footprint = FootprintPath::Auto;
     /// The reconstruction kernel (--kernel; KernelShape::named): every mode and the reference.
     std::string kernel = "gaussian";

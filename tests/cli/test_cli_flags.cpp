@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 /// The render flags every rendering command shares (render_flags.cpp declares them once).
 const std::vector<std::string> kShared{
     "--grid",    "--tf",        "--size",         "--up",          "--view-dir",  "--threshold", "--lod", "--lod-blend",
-    "--footprint", "--filter-order", "--subpixels", "--compositing", "--slab-thickness", "--simd", "--threads", "--shading",
+    "--footprint", "--filter-order", "--subpixels", "--compositing", "--slab-thickness", "--cutoff", "--simd", "--threads", "--shading",
     "--ambient", "--diffuse",   "--specular",     "--shininess",   "--light",     "--gradient-opacity",
     "--emission", "--emission-map", "--emission-scale", "--kelvin"};
 
@@ -179,6 +179,9 @@ TEST_F(CliFlags, SharedFlagsAreParsedAlike) {
         {"--compositing sheets", "--compositing"},
         {"--slab-thickness 0.25", "--slab-thickness"},
         {"--slab-thickness x", "--slab-thickness"},
+        {"--cutoff 0", "--cutoff"},
+        {"--cutoff 0.2", "--cutoff"},
+        {"--cutoff nan", "--cutoff"},
         {"--up 0,0", "--up"},
         {"--view-dir 1,x,0", "--view-dir"},
         {"--shading glossy", "--shading"},

@@ -573,6 +573,39 @@ TEST(Forward, ImagesDoNotDependOnThreadCount) {
     }
 }
 
+// --cutoff ε (RenderSettings::cutoff): a pixel stops taking primitives once T < ε. Every
+// contribution before that is the default render's, and what follows is at most T·(its colour)
+// < ε·1 here (white), so colour and alpha move by less than ε at every pixel, the postfilter's
+// convex weights included; behind the opaque front, fewer primitives are drawn. A cutoff that
+// did nothing, or dropped more than the bound, fails (the default, 1e-4, is the reference's).
+TEST(Forward, CutoffDropsLessThanItsBound) {
+    const Volume box = boxVolume({0, 0, 0}, {23, 23, 23});
+    const TransferFunction tf = constantTf(0.6f);
+    constexpr double kCutoff = 0.01;
+    for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Splat, RenderMode::Point})
+        for (const double distance : {1.0, 8.0}) {
+            SCOPED_TRACE(toString(mode) + " distance " + std::to_string(distance));
+            RenderSettings s = settingsFor(mode, distance);
+            RenderStats full, cut;
+            const Image a = renderWith(box, tf, s, &full);
+            s.cutoff = kCutoff;
+            const Image b = renderWith(box, tf, s, &cut);
+            ASSERT_EQ(a.pixels.size(), b.pixels.size());
+            float largest = 0.f;
+            for (size_t i = 0; i < a.pixels.size(); ++i) {
+                const glm::vec4 d = glm::abs(a.pixels[i] - b.pixels[i]);
+                largest = std::max({largest, d.x, d.y, d.z, d.w});
+            }
+            EXPECT_LT(largest, kCutoff * (1.0 + 1e-3));
+            EXPECT_GT(largest, 0.1 * kCutoff);  // it cut: the front is opaque (e^{-0.6·24} ≪ ε)
+            // Framed, the box spans several depth windows: the later ones' primitives behind the
+            // front are culled (far, its one window is composited before any pixel is finished).
+            if (distance == 1.0) {
+                EXPECT_LT(cut.points + cut.splats, full.points + full.splats);
+            }
+        }
+}
+
 // Buffers kept from render to render (bench, animate, study: render/forward_buffers.h) hold what
 // the previous render left: larger or smaller images, other volumes, the slab order's profiles,
 // aggregates. Each render through them must be bit-identical to a fresh one.
