@@ -12,6 +12,10 @@
 
 namespace vdbsplat {
 
+/// @brief The transmittance below which a pixel is finished (early termination), unless a render
+/// sets another (RenderSettings::cutoff, --cutoff): the reference's (render/reference.h).
+inline constexpr double kDefaultCutoff = 1e-4;
+
 enum class CompositingOrder { Kernels, Slabs };
 
 /// @brief The colour channels the compositor's vector loops carry. Grey: every primitive's colour

@@ -36,9 +36,9 @@
 
 namespace vdbsplat {
 
-/// Transmittance below which a pixel is finished (early termination), by default: the reference's
-/// (render/reference.h). A render may raise it (RenderSettings::cutoff, --cutoff).
-inline constexpr float kTransmittanceEpsilon = 1e-4f;
+/// Transmittance below which a pixel is finished (early termination), by default
+/// (composite/compositing.h). A render may raise it (RenderSettings::cutoff, --cutoff).
+inline constexpr float kTransmittanceEpsilon = float(kDefaultCutoff);
 
 /// @brief What the exact and near-eye paths need to recompute a kernel per tile.
 struct ExactContext {

@@ -94,7 +94,6 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     // light: c·D + S, the same operations on each channel), without emission or the splats' tint
     // (ColorChannels; the same image).
     const bool grey = settings.greyChannel && table.grey() && !emission && !settings.showPrimitives;
-    static_assert(float(kDefaultCutoff) == kTransmittanceEpsilon, "the default cutoff is the compositor's");
     TileCompositor compositor(camera.width(), camera.height(), tables, exact, slabs, &buffers.compositor,
                               grey ? ColorChannels::Grey : ColorChannels::Rgb, float(settings.cutoff));
     stats.compositedChannels = compositor.channels();

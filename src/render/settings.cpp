@@ -51,7 +51,7 @@ void RenderSettings::validate() const {
     if (threads < 0 || threads > 1024) throw Error("--threads: must be in [0, 1024]");
     if (spp < 1 || spp > 1024) throw Error("--spp: must be in [1, 1024]");
     if (!(std::isfinite(threshold) && threshold > 0.0)) throw Error("--threshold: must be a positive number of pixels");
-    if (!(cutoff >= 1e-6 && cutoff <= kMaxCutoff))
+    if (!(cutoff >= kMinCutoff && cutoff <= kMaxCutoff))
         throw Error("--cutoff: must be a transmittance in [1e-6, 0.05]");
     if (!(std::isfinite(lodPx) && lodPx >= 0.0 && lodPx <= 64.0))
         throw Error("--lod: must be a number of pixels in [0, 64] (0 turns level of detail off)");

@@ -18,11 +18,9 @@
 
 namespace vdbsplat {
 
-/// The forward modes' default early-termination transmittance: the reference's (render/reference.h
-/// kReferenceEpsilon, composite/compositor.h kTransmittanceEpsilon).
-inline constexpr double kDefaultCutoff = 1e-4;
-/// The largest --cutoff: what a pixel may drop is at most this much of the brightest colour.
-inline constexpr double kMaxCutoff = 0.05;  // (settings.cpp names it in its error)
+/// --cutoff's range (the default, kDefaultCutoff, is in composite/compositing.h): at most
+/// kMaxCutoff of the brightest colour may be dropped at a pixel (settings.cpp's error names both).
+inline constexpr double kMinCutoff = 1e-6, kMaxCutoff = 0.05;
 
 /// Reference: the ray integrator (ground truth). Hybrid, Splat, Point: Yuan et al. 2003 with the
 /// EWA low-pass on the exact perspective ellipse. The study modes (DESIGN §6, docs/modes.md):
