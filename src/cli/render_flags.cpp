@@ -92,10 +92,10 @@ constexpr RenderFlag kRenderFlags[] = {
      "order, 0.5 in the slabs order): points are summed per slab, and the\n"
      "slabs order composites once per slab"},
     {"--cutoff", "T", kQuality,
-     "early termination: a pixel whose transmittance falls below T takes\n"
-     "nothing more, 1e-6..0.05 (default 1e-4, the reference's); what it drops\n"
-     "is at most T times the brightest colour behind (VTK's CPU ray caster\n"
-     "stops at 0.0078; docs/performance.md)"},
+     "early termination, 1e-6..0.05 (default 1e-3): the deposit that takes a\n"
+     "pixel's transmittance below T takes all of it, with its colour, and the\n"
+     "pixel takes nothing more; the image moves by at most T (VTK's CPU ray\n"
+     "caster stops at 0.0078, the reference at 1e-4; docs/compositing.md)"},
     {"--simd", "on|off", kQuality, "splats through the vector loop (default on) or the scalar table path"},
     {"--show-primitives", nullptr, kQuality, "tint splats red, points keep their colour"},
     {"--tables", "DIR", kQuality,

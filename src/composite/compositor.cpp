@@ -359,14 +359,17 @@ struct TileCompositor::TilePixels {
     }
     /// The vector loops' view; @p grey: T and R alone (ColorChannels::Grey).
     TileBuffers buffers(bool grey) { return {T.data(), R.data(), grey ? nullptr : G.data(), grey ? nullptr : B.data(), x0, y0}; }
-    /// α = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α   (DESIGN §4)
+    /// α = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α   (DESIGN §4), except that a deposit leaving
+    /// T < ε takes the whole remainder: C += T·c, T = 0 (the vector loops' Over).
     void over(int i, float tau, const glm::vec3& color) {
         const float alpha = opacityFromOpticalDepth(tau);
         float& t = T[size_t(i)];
-        R[size_t(i)] += t * alpha * color.x;
-        G[size_t(i)] += t * alpha * color.y;
-        B[size_t(i)] += t * alpha * color.z;
-        t *= 1.f - alpha;
+        const float after = t - t * alpha;  // t·(1 − α)
+        const float ta = after >= epsilon ? t * alpha : t;
+        R[size_t(i)] += ta * color.x;
+        G[size_t(i)] += ta * color.y;
+        B[size_t(i)] += ta * color.z;
+        t = after >= epsilon ? after : 0.f;
     }
 };
 
@@ -620,6 +623,7 @@ void TileCompositor::drawSplat(const TileRecord& p, const ExactIndexMap& map, Ti
         s.x0 = std::max(p.range.x0, px.x0), s.x1 = std::min(p.range.x1, px.x1);
         s.y0 = std::max(p.range.y0, px.y0), s.y1 = std::min(p.range.y1, px.y1);
         s.epsilon = epsilon_;
+        s.safeT = remainderBound(epsilon_, p.scale * tables_.poly.peak());
         s.slabs = slabs;
         drawSplatVector(s, px.buffers(grey_));
         return;

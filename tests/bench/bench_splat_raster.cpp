@@ -60,6 +60,7 @@ std::vector<SplatRaster> splats(double spacingPx, bool exactIndex, bool apart) {
         s.map = makeExactIndexMap(k, sphere, k.centre);
         s.color = glm::vec3(float(u()), float(u()), float(u()));
         s.epsilon = 1e-4f;
+        s.safeT = remainderBound(s.epsilon, s.scale * tables().poly.peak());  // as the compositor sets it
         const PixelRange r = pixelRange(PixelBox{k.bounds.lo + move, k.bounds.hi + move}, kTileSize, kTileSize);
         s.x0 = r.x0, s.y0 = r.y0, s.x1 = r.x1, s.y1 = r.y1;
         if (s.x0 > s.x1 || s.y0 > s.y1) continue;

@@ -66,6 +66,9 @@ bool randomSplat(std::mt19937& rng, bool exactIndex, SplatRaster& s, int& tx0, i
     s.map = makeExactIndexMap(k, sphere, PixelCoord(s.cx, s.cy));
     s.color = glm::vec3(u(rng), u(rng), u(rng));
     s.epsilon = kTransmittanceEpsilon;
+    // Half the splats with the compositor's bound below which lanes are checked for a finishing
+    // deposit, half with every lane checked: the two must agree with the scalar loop alike.
+    if (u(rng) < 0.5f) s.safeT = remainderBound(s.epsilon, s.scale * tables().poly.peak());
     constexpr int kLastTile = 64 / kTileSize - 1;
     tx0 = std::clamp(int(std::floor(s.cx / kTileSize)), 0, kLastTile) * kTileSize;
     ty0 = std::clamp(int(std::floor(s.cy / kTileSize)), 0, kLastTile) * kTileSize;
@@ -74,7 +77,9 @@ bool randomSplat(std::mt19937& rng, bool exactIndex, SplatRaster& s, int& tx0, i
     s.y0 = std::max(r.y0, ty0), s.y1 = std::min(r.y1, ty0 + kTileSize - 1);
     if (s.x0 > s.x1 || s.y0 > s.y1) return false;
     for (size_t i = 0; i < size_t(kTilePixels); ++i) {
-        a.T[i] = u(rng) < 0.1f ? 0.5f * kTransmittanceEpsilon : u(rng);
+        // Finished pixels, pixels a deposit may finish (T a few ε) and the rest.
+        const float kind = u(rng);
+        a.T[i] = kind < 0.1f ? 0.5f * kTransmittanceEpsilon : kind < 0.25f ? kTransmittanceEpsilon * (1.f + 4.f * u(rng)) : u(rng);
         a.R[i] = u(rng), a.G[i] = u(rng), a.B[i] = u(rng);
     }
     return true;
@@ -83,7 +88,7 @@ bool randomSplat(std::mt19937& rng, bool exactIndex, SplatRaster& s, int& tx0, i
 void vectorLoopMatchesTheScalarLoop() {
     std::mt19937 rng(11);
     double worst = 0.0;
-    int drawn = 0;
+    int drawn = 0, remainders = 0;
     for (int trial = 0; trial < 300; ++trial) {
         SplatRaster s;
         int tx0 = 0, ty0 = 0;
@@ -104,10 +109,22 @@ void vectorLoopMatchesTheScalarLoop() {
                 ASSERT_EQ(a.T[i], before.T[i]) << "trial " << trial << " pixel " << i;
                 ASSERT_EQ(b.T[i], before.T[i]) << "trial " << trial << " pixel " << i;
             }
+            // A deposit that finishes a pixel takes its whole remainder, in both loops: C += T·c, T = 0.
+            if (before.T[i] >= kTransmittanceEpsilon && (a.T[i] < kTransmittanceEpsilon || b.T[i] < kTransmittanceEpsilon)) {
+                ++remainders;
+                ASSERT_EQ(a.T[i], 0.f) << "trial " << trial << " pixel " << i;
+                ASSERT_EQ(b.T[i], 0.f) << "trial " << trial << " pixel " << i;
+                const float expected[3] = {before.R[i] + before.T[i] * s.color.x, before.G[i] + before.T[i] * s.color.y,
+                                           before.B[i] + before.T[i] * s.color.z};
+                const float got[2][3] = {{a.R[i], a.G[i], a.B[i]}, {b.R[i], b.G[i], b.B[i]}};
+                for (const auto& g : got)
+                    for (int k = 0; k < 3; ++k) ASSERT_NEAR(g[k], expected[k], 1e-7f) << "trial " << trial << " pixel " << i;
+            }
         }
     }
-    std::printf("  max |vector − scalar| = %.3g over %d changed values\n", worst, drawn);
-    EXPECT_GT(drawn, 1000);  // the loops did draw
+    std::printf("  max |vector − scalar| = %.3g over %d changed values, %d remainders\n", worst, drawn, remainders);
+    EXPECT_GT(drawn, 1000);      // the loops did draw
+    EXPECT_GT(remainders, 100);  // and finished pixels under splats took their remainders
     EXPECT_LT(worst, 2e-6);
 }
 
@@ -271,11 +288,22 @@ void nonFiniteConicStaysInsideItsRange() {
 
 /// The slow compositor: every pixel walks every primitive in the compositor's order
 /// (slab, points before splats, depth, index); points of a slab are summed, then composited
-/// (DESIGN §4); splats are composited one by one with the table path's deposit.
+/// (DESIGN §4); splats are composited one by one with the table path's deposit. The deposit that
+/// leaves T < ε takes the pixel's whole remainder instead (C += T·c, T = 0), and nothing follows.
 Image slowComposite(const std::vector<std::vector<Primitive>>& windows, int w, int h) {
     Image image(w, h);
     std::vector<float> T(size_t(w) * h, 1.f);
     std::vector<glm::vec3> C(size_t(w) * h, glm::vec3(0.f));
+    const auto over = [&](size_t pix, float tau, const glm::vec3& color) {
+        const float a = opacityFromOpticalDepth(tau), after = T[pix] - T[pix] * a;
+        if (after < kTransmittanceEpsilon) {  // the deposit that finishes the pixel takes its remainder
+            C[pix] += T[pix] * color;
+            T[pix] = 0.f;
+            return;
+        }
+        C[pix] += T[pix] * a * color;
+        T[pix] = after;
+    };
     for (const auto& prims : windows) {
         std::vector<size_t> order(prims.size());
         std::iota(order.begin(), order.end(), 0);
@@ -291,11 +319,7 @@ Image slowComposite(const std::vector<std::vector<Primitive>>& windows, int w, i
                 glm::vec3 slabEmission(0.f);
                 int64_t slabOf = INT64_MIN;
                 const auto flush = [&] {
-                    if (slabTau > 0.f) {
-                        const float a = opacityFromOpticalDepth(slabTau);
-                        C[pix] += T[pix] * a * (slabEmission / slabTau);
-                        T[pix] *= 1.f - a;
-                    }
+                    if (slabTau > 0.f) over(pix, slabTau, slabEmission / slabTau);
                     slabTau = 0.f, slabEmission = glm::vec3(0.f);
                 };
                 for (size_t k : order) {
@@ -319,9 +343,7 @@ Image slowComposite(const std::vector<std::vector<Primitive>>& windows, int w, i
                         shader.scale = p.scale;
                         const float tau = p.kind == PrimitiveKind::SplatExactIndex
                                               ? shader.depositAtD2(p.exactMap.d2(i2, dx, dy)) : shader.depositAtIndex2(i2);
-                        const float a = opacityFromOpticalDepth(tau);
-                        C[pix] += T[pix] * a * p.color;
-                        T[pix] *= 1.f - a;
+                        over(pix, tau, p.color);
                     }
                 }
                 flush();

@@ -592,16 +592,25 @@ TEST(Forward, CutoffDropsLessThanItsBound) {
             const Image b = renderWith(box, tf, s, &cut);
             ASSERT_EQ(a.pixels.size(), b.pixels.size());
             float largest = 0.f;
+            double covered = 0.0, moved = 0.0;  // over the pixels the box covers (α > 0.99)
             for (size_t i = 0; i < a.pixels.size(); ++i) {
                 const glm::vec4 d = glm::abs(a.pixels[i] - b.pixels[i]);
                 largest = std::max({largest, d.x, d.y, d.z, d.w});
+                if (a.pixels[i].w > 0.99f) covered += 1.0, moved += d.x;
             }
+            const double meanMoved = moved / std::max(covered, 1.0);
+            std::printf("  %s distance %.0f: largest %.3g, mean over %.0f covered pixels %.3g\n", toString(mode).c_str(),
+                        distance, largest, covered, meanMoved);
             EXPECT_LT(largest, kCutoff * (1.0 + 1e-3));
-            EXPECT_GT(largest, 0.1 * kCutoff);  // it cut: the front is opaque (e^{-0.6·24} ≪ ε)
             // Framed, the box spans several depth windows: the later ones' primitives behind the
             // front are culled (far, its one window is composited before any pixel is finished).
+            // The deposit that finishes a pixel takes its whole remainder, with a colour as white as
+            // what lies behind: the covered pixels move by a small part of ε (without the remainder
+            // they lost up to ε, 0.67 ε on average here).
             if (distance == 1.0) {
                 EXPECT_LT(cut.points + cut.splats, full.points + full.splats);
+                EXPECT_GT(covered, 1000.0);
+                EXPECT_LT(meanMoved, 0.1 * kCutoff);
             }
         }
 }
@@ -740,16 +749,23 @@ TEST(Forward, CroppingToTheVolumeKeepsTheImage) {
         const Image b = renderWith(v, tf, view.s, &whole);
         ASSERT_EQ(a.pixels.size(), b.pixels.size());
         double worst = 0.0, sum = 0.0;
+        int moved = 0;  // pixels off by more than float rounding
         for (size_t i = 0; i < a.pixels.size(); ++i) {
             const glm::vec4 d = glm::abs(a.pixels[i] - b.pixels[i]);
-            worst = std::max(worst, double(std::max(std::max(d.x, d.y), std::max(d.z, d.w))));
+            const double largest = double(std::max(std::max(d.x, d.y), std::max(d.z, d.w)));
+            worst = std::max(worst, largest);
+            moved += largest >= 1e-5;
             sum += b.pixels[i].w;
         }
-        std::printf("  %-6s %-6s %-10s %7llu of %7llu pixels composited, max |Δ| %.2e\n", view.name,
+        std::printf("  %-6s %-6s %-10s %7llu of %7llu pixels composited, max |Δ| %.2e, %d over 1e-5\n", view.name,
                     toString(view.s.mode).c_str(), toString(view.s.filterOrder).c_str(),
-                    (unsigned long long)cropped.compositedPixels, (unsigned long long)whole.compositedPixels, worst);
+                    (unsigned long long)cropped.compositedPixels, (unsigned long long)whole.compositedPixels, worst, moved);
         EXPECT_GT(sum, 1.0) << view.name;  // the volume is in the picture
-        EXPECT_LT(worst, 1e-5) << view.name << " " << toString(view.s.mode) << " " << toString(view.s.filterOrder);
+        // The same image up to float rounding, except where rounding decides which deposit finishes
+        // a pixel (T just at the cutoff ε): that deposit takes the remainder, so such a pixel may move
+        // by up to ε, and the output pixels its postfilter reaches (9 for one such pixel here) with it.
+        EXPECT_LT(worst, kDefaultCutoff) << view.name << " " << toString(view.s.mode) << " " << toString(view.s.filterOrder);
+        EXPECT_LE(moved, 50) << view.name << " " << toString(view.s.mode) << " " << toString(view.s.filterOrder);
         const std::string name = view.name;
         if (name == "far") {
             EXPECT_LT(cropped.compositedPixels * 4, whole.compositedPixels);
