@@ -15,8 +15,8 @@ namespace vdbsplat {
 /// @brief The transmittance below which a pixel is finished (early termination), unless a render
 /// sets another (RenderSettings::cutoff, --cutoff). The deposit that finishes a pixel takes its
 /// whole remainder (T·c, docs/compositing.md), so a cutoff ten times the reference's 1e-4
-/// (render/reference.h) scores at least as well against it on every cell of docs/fidelity.md's
-/// table as 1e-4 without the remainder did (docs/performance.md, session 40).
+/// (render/reference.h) scores against it within 0.01 dB of what 1e-4 without the remainder did,
+/// or better, on every cell of docs/fidelity.md's table (docs/fidelity.md, session 40).
 inline constexpr double kDefaultCutoff = 1e-3;
 
 enum class CompositingOrder { Kernels, Slabs };
