@@ -362,14 +362,10 @@ struct TileCompositor::TilePixels {
     /// α = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α   (DESIGN §4), except that a deposit leaving
     /// T < ε takes the whole remainder: C += T·c, T = 0 (the vector loops' Over).
     void over(int i, float tau, const glm::vec3& color) {
-        const float alpha = opacityFromOpticalDepth(tau);
-        float& t = T[size_t(i)];
-        const float after = t - t * alpha;  // t·(1 − α)
-        const float ta = after >= epsilon ? t * alpha : t;
+        const float ta = takeTransmittance(T[size_t(i)], opacityFromOpticalDepth(tau), epsilon);
         R[size_t(i)] += ta * color.x;
         G[size_t(i)] += ta * color.y;
         B[size_t(i)] += ta * color.z;
-        t = after >= epsilon ? after : 0.f;
     }
 };
 

@@ -124,23 +124,28 @@ HWY_INLINE void DepositSlabs(D d, const SplatRaster& s, V tau, M mask, const Loa
     }
 }
 
+/// The remainder (takeTransmittance, composite/opacity.h): where the transmittance @p next = T − T·α
+/// a deposit leaves falls below ε, the deposit's share @p ta becomes all of @p T and @p next 0.
+template <class D, class V>
+HWY_INLINE void TakeRemainder(D d, V T, float epsilon, V& ta, V& next) {
+    const auto goesOn = hn::Ge(next, hn::Set(d, epsilon));
+    ta = hn::IfThenElse(goesOn, ta, T);
+    next = hn::IfThenElseZero(goesOn, next);
+}
+
 /// "Over" at the lanes of @p mask (DESIGN §4): α = 1 − e^{−τ}, C += T·α·c, T' = T − T·α, except
 /// where T' < ε, which takes the whole remainder: C += T·c, T' = 0 (the deposit that finishes a
-/// pixel stands for what lies behind it; docs/compositing.md, "Early termination"). @p load and
-/// @p store as Deposit's.
-/// Lanes at or above @p safeT (SplatRaster::safeT) cannot finish: a vector whose masked lanes all
-/// are takes no test (the finishing test waits on α, and cost 10 % of the loop when every vector
-/// took it; docs/performance.md, session 40).
+/// pixel stands for what lies behind it; docs/compositing.md, "Early termination and the
+/// remainder"). @p load and @p store as Deposit's. No lane at or above @p safeT
+/// (SplatRaster::safeT) can finish, so a vector none of whose drawn lanes lies below it skips the
+/// test, which waits on α and cost 10 % of the loop when every vector took it (docs/performance.md,
+/// session 40).
 template <bool kGrey, class D, class V, class M, class Load, class Store>
 HWY_INLINE void Over(D d, V alpha, V T, float epsilon, float safeT, M mask, const V (&rgb)[3], const TileBuffers& tile,
                      const Load& load, const Store& store) {
     V ta = hn::Mul(T, alpha);   // T·α
     V next = hn::Sub(T, ta);    // T·(1 − α)
-    if (HWY_UNLIKELY(!hn::AllFalse(d, hn::And(mask, hn::Lt(T, hn::Set(d, safeT)))))) {
-        const auto goesOn = hn::Ge(next, hn::Set(d, epsilon));
-        ta = hn::IfThenElse(goesOn, ta, T);  // or the remainder T
-        next = hn::IfThenElseZero(goesOn, next);
-    }
+    if (HWY_UNLIKELY(!hn::AllFalse(d, hn::And(mask, hn::Lt(T, hn::Set(d, safeT)))))) TakeRemainder(d, T, epsilon, ta, next);
     const V R = load(tile.R);
     store(tile.R, hn::IfThenElse(mask, hn::MulAdd(ta, rgb[0], R), R));
     if constexpr (!kGrey) {
@@ -457,17 +462,16 @@ void CompositeSlabFor(float* tau, float* er, float* eg, float* eb, const TileBuf
             const V T = hn::Load(d, tile.T + i);
             const auto mask = hn::And(hn::Gt(t, zero), hn::Ge(T, eps));
             if (!hn::AllFalse(d, mask)) {
-                const V ta0 = hn::Mul(T, OpacityFromTau(d, t));  // T·α
-                const V after = hn::Sub(T, ta0);
-                const auto goesOn = hn::Ge(after, eps);
-                const V ta = hn::IfThenElse(goesOn, ta0, T);  // or the remainder (Over)
+                V ta = hn::Mul(T, OpacityFromTau(d, t));  // T·α
+                V next = hn::Sub(T, ta);
+                TakeRemainder(d, T, epsilon, ta, next);
                 const V w = hn::IfThenElseZero(mask, hn::Div(ta, hn::IfThenElse(mask, t, hn::Set(d, 1.f))));
                 hn::Store(hn::MulAdd(w, hn::Load(d, er + i), hn::Load(d, tile.R + i)), d, tile.R + i);
                 if constexpr (!kGrey) {
                     hn::Store(hn::MulAdd(w, hn::Load(d, eg + i), hn::Load(d, tile.G + i)), d, tile.G + i);
                     hn::Store(hn::MulAdd(w, hn::Load(d, eb + i), hn::Load(d, tile.B + i)), d, tile.B + i);
                 }
-                hn::Store(hn::IfThenElse(mask, hn::IfThenElseZero(goesOn, after), T), d, tile.T + i);
+                hn::Store(hn::IfThenElse(mask, next, T), d, tile.T + i);
             }
             hn::Store(zero, d, tau + i), hn::Store(zero, d, er + i);
             if constexpr (!kGrey) hn::Store(zero, d, eg + i), hn::Store(zero, d, eb + i);
@@ -519,13 +523,9 @@ void drawSplatScalarPoly(const SplatRaster& s, const TileBuffers& tile) {
                 }
                 continue;
             }
-            const float alpha = opacityFromOpticalDepth(tau);
-            const float after = tile.T[i] - tile.T[i] * alpha;
-            const bool goesOn = after >= s.epsilon;
-            const float ta = goesOn ? tile.T[i] * alpha : tile.T[i];  // T·α, or the remainder (Over)
+            const float ta = takeTransmittance(tile.T[i], opacityFromOpticalDepth(tau), s.epsilon);
             tile.R[i] += ta * s.color.x;
             if (tile.G) tile.G[i] += ta * s.color.y, tile.B[i] += ta * s.color.z;  // else one channel
-            tile.T[i] = goesOn ? after : 0.f;
         }
     }
 }
