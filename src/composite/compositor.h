@@ -7,7 +7,9 @@
 //     σ-weighted colour) and composited when the slab ends, so side-by-side
 //     points never occlude each other;
 //   - splats are composited one by one ("over") after the points of their slab;
-//   - α = 1 − exp(−τ), C += T·α·c, T *= 1 − α;
+//   - α = 1 − exp(−τ), C += T·α·c, T *= 1 − α, except that the deposit that
+//     takes T below ε takes all of it, C += T·c, T = 0 (the remainder:
+//     takeTransmittance, composite/opacity.h; docs/compositing.md);
 //   - a pixel whose T < ε takes no more work; a tile whose pixels all have
 //     T < ε takes no more primitives, and blocks hidden behind such tiles are
 //     never streamed (hidden()).

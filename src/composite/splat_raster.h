@@ -10,7 +10,8 @@
 //     i² = Qxx dx² + 2 Qxy dx dy + Qyy dy²        (the widened conic, screen_kernel.h)
 //     t  = i² (table path) or the exact d² (ExactIndexMap, --footprint auto off the axis)
 //     τ  = scale · √(1 − t) · G_α(t)             (scale = σ·h·amplitude; DESIGN §3, §4)
-//     α  = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α  (DESIGN §4, front to back)
+//     α  = 1 − exp(−τ);  C += T·α·c;  T *= 1 − α  (DESIGN §4, front to back; the deposit that
+//                                               takes T below ε takes all of it: the remainder)
 // or, with `slabs` (--compositing slabs), τ·fraction_j and τ·fraction_j·c added to slab j's sums.
 // Pixels with i² ≥ 1, outside the splat's clipped range or already opaque (T < ε) keep their values.
 #pragma once
@@ -92,7 +93,8 @@ inline float remainderBound(float epsilon, float tauBound) {
 /// @brief A slab's sums in the tile's pixels @p rect (both orders: the points' slabs of the kernel
 /// order, every slab of --compositing slabs): the optical depth @p tau and σ-weighted emission
 /// @p er, @p eg, @p eb (kTilePixels each) composited onto @p tile's live pixels (T ≥ @p epsilon),
-/// α = 1 − e^{−τ}, C += T·α·e/τ, T *= 1 − α; then the slab emptied there. The rectangle's columns
+/// α = 1 − e^{−τ}, C += T·α·e/τ, T *= 1 − α (or, where that leaves T < ε, the remainder: C += T·e/τ,
+/// T = 0); then the slab emptied there. The rectangle's columns
 /// are read in whole vectors: every pixel outside it must hold τ = 0 (it is left unchanged then).
 /// A @p tile without G and B (one channel) reads and empties @p tau and @p er alone.
 /// Vectorised (Highway).

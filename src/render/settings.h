@@ -18,8 +18,8 @@
 
 namespace vdbsplat {
 
-/// --cutoff's range (the default, kDefaultCutoff, is in composite/compositing.h): at most
-/// kMaxCutoff of the brightest colour may be dropped at a pixel (settings.cpp's error names both).
+/// --cutoff's range (the default, kDefaultCutoff, is in composite/compositing.h): a pixel may move by
+/// at most kMaxCutoff (settings.cpp's error names both).
 inline constexpr double kMinCutoff = 1e-6, kMaxCutoff = 0.05;
 
 /// Reference: the ray integrator (ground truth). Hybrid, Splat, Point: Yuan et al. 2003 with the
@@ -102,9 +102,10 @@ struct RenderSettings {
     int threads = 0;                        ///< 0: all cores
     int spp = 16;                           ///< reference: rays per pixel (rounded to a square)
     double threshold = 1.0;                 ///< τ: projected voxel spacing (px) below which voxels are points
-    /// ε, early termination (--cutoff): a pixel whose transmittance falls below it takes nothing
-    /// more, and blocks and primitives behind such pixels are skipped. What it drops is at most
-    /// ε·(the brightest colour behind) per pixel; the default is the reference's (kDefaultCutoff).
+    /// ε, early termination (--cutoff): the deposit that takes a pixel's transmittance below it
+    /// takes all of it (the remainder, docs/compositing.md), the pixel takes nothing more, and
+    /// blocks and primitives behind such pixels are skipped. A pixel moves by at most ε times the
+    /// colour difference between what finished it and what lay behind (kDefaultCutoff: 1e-3).
     double cutoff = kDefaultCutoff;
     FootprintPath footprint = FootprintPath::Auto;
     /// The reconstruction kernel (--kernel; KernelShape::named): every mode and the reference.
