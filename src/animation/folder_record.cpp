@@ -16,4 +16,12 @@ bool sameAnimation(const nlohmann::json& old, nlohmann::json record, const std::
     return old == record;
 }
 
+bool olderBuildsRecord(const nlohmann::json& old, nlohmann::json record, const std::string& cameraText) {
+    if (!old.contains("settings") || !old["settings"].is_object() || !record.contains("settings")) return false;
+    bool lacks = false;
+    for (const char* key : {"cutoff", "compositing", "slab_thickness"})
+        if (!old["settings"].contains(key) && record["settings"].contains(key)) record["settings"].erase(key), lacks = true;
+    return lacks && sameAnimation(old, std::move(record), cameraText);
+}
+
 }  // namespace vdbsplat::animation

@@ -421,7 +421,7 @@ int runAnimate(const Args& args) {
     // What the frames are made of: --resume refuses a folder made otherwise.
     std::error_code canonicalEc;
     const std::string inputId = fs::weakly_canonical(o.input, canonicalEc).string();
-    nlohmann::json settingsJson = o.settings.toJson();
+    nlohmann::json settingsJson = o.settings.identityJson();
     settingsJson.erase("distance");
     nlohmann::json record = {{"input", inputId},       {"grid", volume.name}, {"settings", settingsJson},
                              {"format", o.format},     {"frames", M},         {"cameras_fnv1a", animation::cameraFingerprint(cameraText)},
@@ -432,9 +432,14 @@ int runAnimate(const Args& args) {
                                 {"frames", M},          {"cameras_fnv1a", animation::cameraFingerprint(cameraText)}};
     const fs::path refDir = dir / "reference";
     if (o.resume) {
-        if (auto old = readJson(dir / "animation.json"); old && !animation::sameAnimation(*old, record, cameraText))
+        if (auto old = readJson(dir / "animation.json"); old && !animation::sameAnimation(*old, record, cameraText)) {
+            if (animation::olderBuildsRecord(*old, record, cameraText))
+                throw Error(o.dir + ": --resume: the folder was made by an older vdbsplat, whose record leaves out "
+                            "--cutoff (its default was 1e-4 until 2026-11-29, today's is 1e-3): new frames might not "
+                            "match its frames (use --force to start afresh)");
             throw Error(o.dir + ": --resume: the folder holds another animation (input, settings, path or "
                         "--reference differ; use --force to start afresh)");
+        }
         if (o.reference)
             if (auto old = readJson(refDir / "reference.json"); old && !animation::sameAnimation(*old, refRecord, cameraText))
                 throw Error((refDir / "reference.json").string() +

@@ -282,9 +282,11 @@ nlohmann::json volumeIdentity(const std::string& input, const Volume& volume) {
 }
 
 /// The fingerprinted description of one render: the volume and the settings that change its
-/// pixels (the reference ignores the forward modes' knobs; the forward modes ignore --spp).
+/// pixels (the reference ignores the forward modes' knobs; the forward modes ignore --spp), each
+/// written even at its default (identityJson): a render of an older build made at another default
+/// (--cutoff 1e-4 before session 40) is rendered again, not kept.
 nlohmann::json renderIdentity(const nlohmann::json& volume, const RenderSettings& s) {
-    nlohmann::json settings = s.toJson();
+    nlohmann::json settings = s.identityJson();
     if (s.mode == RenderMode::Reference) {
         for (const char* k : {"threshold", "footprint", "filter_order", "subpixels", "lod", "simd", "show_primitives", "tables"})
             settings.erase(k);

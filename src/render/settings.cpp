@@ -160,6 +160,16 @@ nlohmann::json RenderSettings::toJson() const {
     return j;
 }
 
+nlohmann::json RenderSettings::identityJson() const {
+    nlohmann::json j = toJson();
+    if (mode != RenderMode::Reference) {
+        j["cutoff"] = cutoff;
+        j["compositing"] = toString(effectiveCompositing());
+        j["slab_thickness"] = effectiveSlabThickness();
+    }
+    return j;
+}
+
 nlohmann::json RenderStats::toJson() const {
     nlohmann::json j;
     j["seconds"] = seconds;

@@ -177,7 +177,14 @@ struct RenderSettings {
 
     /// @throw Error naming the flag of the first invalid value (--tables: DIR must be a directory).
     void validate() const;
+    /// The settings as written beside outputs (image metadata, --stats): a setting at its default
+    /// that older builds did not write (cutoff, compositing, slab_thickness) is left out, so such
+    /// outputs stay as they were.
     nlohmann::json toJson() const;
+    /// toJson() with those settings written even at their defaults: what `animate` and `study`
+    /// fingerprint for --resume. A default that changes between builds (--cutoff's 1e-4 → 1e-3,
+    /// session 40) then makes an older folder's record differ instead of matching silently.
+    nlohmann::json identityJson() const;
 };
 
 struct ForwardBuffers;  // render/forward_buffers.h

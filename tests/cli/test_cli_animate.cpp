@@ -156,6 +156,21 @@ TEST_F(AnimateCli, ResumeKeepsFramesAndRerendersADeletedOne) {
     EXPECT_FALSE(fs::exists(dir + "/frame_0003.png.tmp4242.png"));
     // --resume with other settings is refused.
     test::expectOneLineError(animate(args + " --resume --threshold 2"), "another animation");
+    // So is a folder whose record an older build wrote: it left out --cutoff at its default, which
+    // was 1e-4 then; today's record holds it. Nothing is touched.
+    {
+        const std::string json = dir + "/animation.json";
+        const std::string recordText = slurp(json);
+        nlohmann::json record = nlohmann::json::parse(recordText);
+        ASSERT_TRUE(record.at("settings").contains("cutoff"));
+        for (const char* key : {"cutoff", "compositing", "slab_thickness"}) record["settings"].erase(key);
+        spit(json, record.dump(2));
+        const auto frameTime = fs::last_write_time(dir + "/frame_0000.png");
+        test::expectOneLineError(animate(args + " --resume"), "older vdbsplat");
+        EXPECT_EQ(fs::last_write_time(dir + "/frame_0000.png"), frameTime);
+        spit(json, recordText);
+        ASSERT_EQ(animate(args + " --resume").rc, 0);  // its own record back: accepted again
+    }
     // --force starts afresh, and a shorter run leaves no stale frames behind.
     const CliResult f = animate("-o '" + dir + "' --from 3 --to 1 --frames 2 --size 32x32 --force");
     ASSERT_EQ(f.rc, 0) << f.err;

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "study/views.h"
 #include "support/cli.h"
 
 namespace vdbsplat {
@@ -188,13 +189,28 @@ TEST_F(StudyCli, ResumeKeepsRendersAndRedoesOnlyWhatIsMissingOrChanged) {
     EXPECT_NE(png.out.find("(0 rendered, 6 kept)"), std::string::npos) << png.out;
     EXPECT_EQ(readImage(viewDir + "/point.png").width, 48);
 
+    // A render whose record an older build wrote (no cutoff, compositing or slab thickness in its
+    // identity: they were left out at their defaults, and --cutoff's default was 1e-4 then) is
+    // rendered again, not kept: its fingerprint is not today's.
+    {
+        nlohmann::json side = nlohmann::json::parse(slurp(viewDir + "/hybrid.json"));
+        nlohmann::json identity = side.at("made_from");
+        ASSERT_TRUE(identity.at("settings").contains("cutoff"));
+        for (const char* key : {"cutoff", "compositing", "slab_thickness"}) identity["settings"].erase(key);
+        side["made_from"] = identity;
+        side["fingerprint"] = study::fnv1a(identity.dump());
+        spit(viewDir + "/hybrid.json", side.dump(2));
+        const CliResult older = study(args + " --resume");
+        EXPECT_NE(older.out.find("(1 rendered, 5 kept)"), std::string::npos) << older.out;
+    }
+
     // Other forward settings: the forward modes again, the references kept; other spp: the reverse.
     const CliResult threshold = study(args + " --resume --threshold 2");
     EXPECT_NE(threshold.out.find("(4 rendered, 2 kept)"), std::string::npos) << threshold.out;
     const std::string spp = "-o '" + dir + "' --size 48x48 --spp 1 --modes hybrid,point --distances 2,0.5 --threshold 2";
     const CliResult refs = study(spp + " --resume");
     EXPECT_NE(refs.out.find("(2 rendered, 4 kept)"), std::string::npos) << refs.out;
-    EXPECT_EQ(lines(slurp(dir + "/command.txt")).size(), 6u);  // one line per run that started
+    EXPECT_EQ(lines(slurp(dir + "/command.txt")).size(), 7u);  // one line per run that started
 
     // --force starts afresh.
     const CliResult forced = study(args + " --force");
