@@ -32,6 +32,7 @@ constexpr double kMaxPointSpacingSubpx = 2.0;
 struct ForwardPass {
     double threshold;          ///< τ (px): projected voxel spacing below which voxels are points
     double lodPx;              ///< level-of-detail cell size (px)
+    double lodCoarsePx;        ///< its second cap, for 4³ and 8³ cells (px; RenderSettings::lodCoarsePx)
     double prefilterVariance;  ///< V_h folded into each minified primitive (px²)
     double magnifiedPrefilterVariance;  ///< and into magnified ones (the ramp's end; footprint/prefilter.h)
     /// The low-pass the level-of-detail rule weighs an aggregate's spread against (px²; volume/stream.h):
@@ -70,6 +71,7 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     // bounds still narrow it; windows split only at slab boundaries, so the image is the same).
     streamOptions.slabsPerWindow = int(std::lround(streamOptions.slabsPerWindow / streamOptions.slabThickness));
     streamOptions.lodCellPx = pass.lodPx;
+    streamOptions.lodCoarseCellPx = pass.lodCoarsePx;
     streamOptions.keepMoments = control.buffers && control.buffers->keepMoments;  // bench, animate, study, --warmup
     streamOptions.lodBlend = settings.effectiveLodBlend();
     streamOptions.pointPrefilterVariance = pass.lodPrefilterVariance;
@@ -220,7 +222,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     if (settings.filterOrder == FilterOrder::Prefilter || modeFixesFilterOrder(settings.mode)) {
         const bool none = settings.mode == RenderMode::None;
         const double v = none ? 0.0 : kPrefilterVariance;
-        const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, v, v, v};
+        const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, none ? 0.0 : settings.effectiveLodCoarsePx(), v, v, v};
         const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, tables.kernel()), 0);
         const auto at = [&](int x0, int y0) {
             return [&camera, x0, y0](const FrameView& f) { return placed(f, x0, y0, camera.width(), camera.height()); };
@@ -236,7 +238,7 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     const SubpixelGrid grid = makeSubpixelGrid(settings.subpixels, kPrefilterVariance);
     const Camera fine = subpixelCamera(camera, grid);
     const int k = grid.k;
-    const ForwardPass pass{subpixelThreshold(settings.threshold, k), settings.lodPx * k, grid.fineVariance,
+    const ForwardPass pass{subpixelThreshold(settings.threshold, k), settings.lodPx * k, settings.effectiveLodCoarsePx() * k, grid.fineVariance,
                            grid.magnifiedVariance, grid.fineVariance * k};
     // Deposits reach depositReachPx sub-pixels (≤ that many pixels) past the kernels; the output
     // pixels they reach through the filter lie within `border` more; the crop of the sub-pixel

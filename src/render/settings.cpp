@@ -55,6 +55,8 @@ void RenderSettings::validate() const {
         throw Error("--cutoff: must be a transmittance in [1e-6, 0.05]");
     if (!(std::isfinite(lodPx) && lodPx >= 0.0 && lodPx <= 64.0))
         throw Error("--lod: must be a number of pixels in [0, 64] (0 turns level of detail off)");
+    if (lodCoarsePx != 0.0 && !(std::isfinite(lodCoarsePx) && lodCoarsePx >= lodPx && lodCoarsePx <= 64.0))
+        throw Error("--lod: the second cap (PX,PX2) must be a number of pixels in [PX, 64]");
     if ((subpixels < 1 && subpixels != kAutoSubpixels) || subpixels > kMaxSubpixels)
         throw Error("--subpixels: must be 'auto' or in [1, " + std::to_string(kMaxSubpixels) + "]");
     if (maxActiveVoxels < 1 || maxActiveVoxels > kHardMaxActiveVoxels)
@@ -149,6 +151,8 @@ nlohmann::json RenderSettings::toJson() const {
     else j["subpixels"] = subpixels;
     j["show_primitives"] = showPrimitives;
     j["lod"] = mode == RenderMode::None ? 0.0 : lodPx;
+    if (mode != RenderMode::None && mode != RenderMode::Reference && effectiveLodCoarsePx() > lodPx)
+        j["lod_coarse"] = effectiveLodCoarsePx();  // absent with one cap: outputs unchanged
     if (mode != RenderMode::Reference && mode != RenderMode::None) j["lod_blend"] = toString(effectiveLodBlend());
     if (effectiveCompositing() != CompositingOrder::Kernels && mode != RenderMode::Reference)
         j["compositing"] = toString(effectiveCompositing());  // absent for kernels: unshaded outputs unchanged
@@ -166,6 +170,7 @@ nlohmann::json RenderSettings::identityJson() const {
         j["cutoff"] = cutoff;
         j["compositing"] = toString(effectiveCompositing());
         j["slab_thickness"] = effectiveSlabThickness();
+        j["lod_coarse"] = mode == RenderMode::None ? 0.0 : effectiveLodCoarsePx();
     }
     return j;
 }

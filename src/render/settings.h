@@ -131,6 +131,11 @@ struct RenderSettings {
     /// cap the spread a cell adds beside the points' filter decides (kLodMaxSpreadRatio,
     /// volume/stream.h; docs/performance.md, sessions 3 and 20).
     double lodPx = 1.25;
+    /// `--lod PX,PX2`: PX2, the cap for 4³ and 8³ cells in still images (StreamOptions::
+    /// lodCoarseCellPx); 0 (the default): lodPx for every level.
+    double lodCoarsePx = 0.0;
+    /// The second cap in effect: lodCoarsePx where it is above lodPx, else lodPx.
+    double effectiveLodCoarsePx() const { return lodPx > 0.0 && lodCoarsePx > lodPx ? lodCoarsePx : lodPx; }
     /// How blocks pass from one level of detail to the next (volume/stream.h LodBlend, kLodPassage):
     /// On, blended as the camera moves (no pop in a zoom); Off, each block switches at once where a
     /// level becomes admissible; Still, the first passage (voxels → 2³) switches, the later blend.
@@ -181,7 +186,7 @@ struct RenderSettings {
     /// that older builds did not write (cutoff, compositing, slab_thickness) is left out, so such
     /// outputs stay as they were.
     nlohmann::json toJson() const;
-    /// toJson() with those settings written even at their defaults: what `animate` and `study`
+    /// toJson() with those settings (and lod_coarse) written even at their defaults: what `animate` and `study`
     /// fingerprint for --resume. A default that changes between builds (--cutoff's 1e-4 → 1e-3,
     /// session 40) then makes an older folder's record differ instead of matching silently.
     nlohmann::json identityJson() const;

@@ -250,7 +250,12 @@ void VoxelStream::lodLevel(Block& b) const {
     const double filter = pointFilterVariance(spacingPx, options_.pointPrefilterVariance);
     const double bySize = std::log2(options_.lodCellPx / spacingPx);
     const double bySpread = 0.5 * std::log2(1.0 + 12.0 * kLodMaxSpreadRatio * filter / (spacingPx * spacingPx));
-    const double ell = std::min(bySize, bySpread);
+    double ell = std::min(bySize, bySpread);
+    // The second cap (StreamOptions::lodCoarseCellPx): past the first passage's start, the level
+    // the coarser cap admits; the first passage itself keeps lodCellPx, whose losses a larger cap
+    // would bring there (session 33's sweep).
+    if (options_.lodCoarseCellPx > options_.lodCellPx && options_.lodBlend != LodBlend::On && ell >= 1.0)
+        ell = std::max(ell, std::min(std::log2(options_.lodCoarseCellPx / spacingPx), bySpread));
     // The level switches at once where it becomes admissible: everywhere (Off), or in the first
     // passage (Still: from ℓ = 1 the block is 2³ cells, which meets the blended rule at ℓ = 1.75).
     const bool switching = options_.lodBlend == LodBlend::Off ||

@@ -117,6 +117,14 @@ struct StreamOptions {
     /// only while the spread a cell adds stays within kLodMaxSpreadRatio of the variance of the
     /// points it replaces (pointFilterVariance with the pass's low-pass below).
     double lodCellPx = 1.0;
+    /// A second cap for the levels past 2³ cells (4³ and 8³), still images only (LodBlend Still
+    /// and Off): once a block's level is admissible under lodCellPx (ℓ ≥ 1), ℓ may rise to what
+    /// this cap admits (within the same spread bound). 0, or not above lodCellPx: one cap. Opt-in
+    /// (`--lod PX,PX2`): smooth content (CT, the Engine, the Bonsai) gains 1–3.6 dB and far views
+    /// draw up to 3× fewer points with 1.5, but sharp-edged opaque content loses up to 6 dB
+    /// (the checker box; docs/performance.md, session 41). Blended zooms (On) ignore it: their
+    /// first passage would jump.
+    double lodCoarseCellPx = 0.0;
     /// Level of detail, blended (docs/performance.md, "Level of detail"): On, a block passes from
     /// one level to the next continuously as the camera moves, drawn at both with its optical depth
     /// split between them, so no cell pops during a zoom; Off, the level switches at once where

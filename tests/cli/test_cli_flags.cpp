@@ -163,6 +163,10 @@ TEST_F(CliFlags, SharedFlagsAreParsedAlike) {
     const std::vector<std::pair<std::string, std::string>> bad = {
         {"--lod -1", "--lod"},
         {"--lod nan", "--lod"},
+        {"--lod 1.5,1.25", "second cap"},
+        {"--lod 1.25,", "--lod"},
+        {"--lod 1.25,x", "--lod"},
+        {"--lod 1.25,65", "second cap"},
         {"--lod-blend maybe", "--lod-blend"},
         {"--lod 1 --lod 2", "--lod: given more than once"},
         {"--size 10x", "--size"},

@@ -475,6 +475,42 @@ TEST(Forward, LevelOfDetailAggregatesHalfPixelVoxels) {
     EXPECT_GT(switchingToRef, noneToRef - 0.5);
 }
 
+// `--lod PX,PX2`: the second cap coarsens only past the first passage. Where the voxels are still
+// voxels under PX (≈ 0.7 px: a single cap of PX2 would make them 2³ cells, Marschner–Lobb's 4 dB
+// loss of session 33), the image is the default's bit for bit; farther (≈ 0.35 px: 2³ cells on
+// their way to 4³), it draws fewer, coarser points with the same energy; a blended zoom ignores it.
+TEST(Forward, SecondLevelOfDetailCapCoarsensOnlyPastTheFirstPassage) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    RenderSettings s = settingsFor(RenderMode::Hybrid, 1.5);  // 96²: voxels at ≈ 0.73 px
+    RenderStats one, two, single;
+    const Image near0 = renderWith(marschnerLobb(), tf, s, &one);
+    s.lodCoarsePx = 1.5;
+    const Image near1 = renderWith(marschnerLobb(), tf, s, &two);
+    EXPECT_TRUE(near0.pixels == near1.pixels);
+    EXPECT_EQ(one.lodAggregates, 0u);
+    s.lodPx = 1.5, s.lodCoarsePx = 0.0;  // one cap of 1.5: this view would be aggregated
+    renderWith(marschnerLobb(), tf, s, &single);
+    EXPECT_GT(single.lodAggregates, 0u);
+
+    s = settingsFor(RenderMode::Hybrid, 3.2);  // voxels at ≈ 0.35 px
+    const TransferFunction thin = constantTf(0.0001f);
+    RenderStats far0, far1;
+    const Image a = renderWith(marschnerLobb(), thin, s, &far0);
+    s.lodCoarsePx = 1.5;
+    const Image b = renderWith(marschnerLobb(), thin, s, &far1);
+    std::printf("  far: %llu points with one cap, %llu with the second\n", (unsigned long long)far0.points,
+                (unsigned long long)far1.points);
+    EXPECT_LT(far1.points * 2, far0.points);
+    double sa = 0.0, sb = 0.0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) sa += a.pixels[i].w, sb += b.pixels[i].w;
+    EXPECT_NEAR(sb / sa, 1.0, 1e-4);
+    s.lodBlend = LodBlend::On;
+    const Image blended1 = renderWith(marschnerLobb(), thin, s);
+    s.lodCoarsePx = 0.0;
+    const Image blended0 = renderWith(marschnerLobb(), thin, s);
+    EXPECT_TRUE(blended0.pixels == blended1.pixels);
+}
+
 // A zoom from far to near crosses the level changes (8³ → 4³ → 2³ → voxels) and then the point/splat
 // switch: every frame with LOD stays close to the frame without it. (Between frames, the level
 // changes themselves: ZoomStepsAcrossLevelChangesAreSmooth.)
