@@ -1,6 +1,7 @@
 // animation/folder_record.cpp — see folder_record.h.
 #include "animation/folder_record.h"
 
+#include "render/settings.h"
 #include "util/fnv1a.h"
 
 namespace vdbsplat::animation {
@@ -19,7 +20,7 @@ bool sameAnimation(const nlohmann::json& old, nlohmann::json record, const std::
 bool olderBuildsRecord(const nlohmann::json& old, nlohmann::json record, const std::string& cameraText) {
     if (!old.contains("settings") || !old["settings"].is_object() || !record.contains("settings")) return false;
     bool lacks = false;
-    for (const char* key : {"cutoff", "compositing", "slab_thickness"})
+    for (const char* key : RenderSettings::kIdentityOnlyKeys)
         if (!old["settings"].contains(key) && record["settings"].contains(key)) record["settings"].erase(key), lacks = true;
     return lacks && sameAnimation(old, std::move(record), cameraText);
 }

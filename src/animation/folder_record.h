@@ -18,8 +18,8 @@ std::string cameraFingerprint(const std::string& cameraText);
 bool sameAnimation(const nlohmann::json& old, nlohmann::json record, const std::string& cameraText);
 
 /// @brief True if @p old, a folder's record that sameAnimation() rejects, would match @p record
-/// without the settings that older builds wrote only away from their defaults (cutoff,
-/// compositing, slab_thickness; RenderSettings::identityJson) and that @p old lacks: a folder of
+/// without the settings that older builds wrote only away from their defaults
+/// (RenderSettings::kIdentityOnlyKeys) and that @p old lacks: a folder of
 /// the same animation made by a build whose defaults may have been other (--cutoff: 1e-4 until
 /// session 40), which --resume refuses with its own message.
 bool olderBuildsRecord(const nlohmann::json& old, nlohmann::json record, const std::string& cameraText);

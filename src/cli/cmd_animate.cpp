@@ -435,8 +435,8 @@ int runAnimate(const Args& args) {
         if (auto old = readJson(dir / "animation.json"); old && !animation::sameAnimation(*old, record, cameraText)) {
             if (animation::olderBuildsRecord(*old, record, cameraText))
                 throw Error(o.dir + ": --resume: the folder was made by an older vdbsplat, whose record leaves out "
-                            "--cutoff (its default was 1e-4 until 2026-11-29, today's is 1e-3): new frames might not "
-                            "match its frames (use --force to start afresh)");
+                            "settings at their defaults (--cutoff's was 1e-4 until 2026-11-29, today's is 1e-3): new "
+                            "frames might not match its frames (use --force to start afresh)");
             throw Error(o.dir + ": --resume: the folder holds another animation (input, settings, path or "
                         "--reference differ; use --force to start afresh)");
         }

@@ -167,7 +167,7 @@ nlohmann::json RenderSettings::toJson() const {
 nlohmann::json RenderSettings::identityJson() const {
     nlohmann::json j = toJson();
     if (mode != RenderMode::Reference) {
-        j["cutoff"] = cutoff;
+        j["cutoff"] = cutoff;  // kIdentityOnlyKeys, in order
         j["compositing"] = toString(effectiveCompositing());
         j["slab_thickness"] = effectiveSlabThickness();
         j["lod_coarse"] = mode == RenderMode::None ? 0.0 : effectiveLodCoarsePx();

@@ -3,6 +3,7 @@
 // --stats JSON so every run is reproducible from its own output — the OpenVDB
 // options-struct pattern) and RenderStats (what a render measured).
 #pragma once
+#include <array>
 #include <nlohmann/json.hpp>
 #include <functional>
 #include <string>
@@ -186,10 +187,14 @@ struct RenderSettings {
     /// that older builds did not write (cutoff, compositing, slab_thickness) is left out, so such
     /// outputs stay as they were.
     nlohmann::json toJson() const;
-    /// toJson() with those settings (and lod_coarse) written even at their defaults: what `animate` and `study`
+    /// toJson() with kIdentityOnlyKeys written even at their defaults: what `animate` and `study`
     /// fingerprint for --resume. A default that changes between builds (--cutoff's 1e-4 → 1e-3,
     /// session 40) then makes an older folder's record differ instead of matching silently.
     nlohmann::json identityJson() const;
+    /// The settings identityJson() writes at their defaults and toJson() (and builds before session
+    /// 41's fingerprints) leave out there (forward modes).
+    static constexpr std::array<const char*, 4> kIdentityOnlyKeys = {"cutoff", "compositing", "slab_thickness",
+                                                                     "lod_coarse"};
 };
 
 struct ForwardBuffers;  // render/forward_buffers.h

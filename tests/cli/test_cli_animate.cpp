@@ -156,14 +156,15 @@ TEST_F(AnimateCli, ResumeKeepsFramesAndRerendersADeletedOne) {
     EXPECT_FALSE(fs::exists(dir + "/frame_0003.png.tmp4242.png"));
     // --resume with other settings is refused.
     test::expectOneLineError(animate(args + " --resume --threshold 2"), "another animation");
-    // So is a folder whose record an older build wrote: it left out --cutoff at its default, which
-    // was 1e-4 then; today's record holds it. Nothing is touched.
+    // So is a folder whose record an older build wrote: it left out --cutoff, --compositing,
+    // --slab-thickness and the second --lod cap at their defaults (--cutoff's was 1e-4 then);
+    // today's record holds them. Nothing is touched.
     {
         const std::string json = dir + "/animation.json";
         const std::string recordText = slurp(json);
         nlohmann::json record = nlohmann::json::parse(recordText);
         ASSERT_TRUE(record.at("settings").contains("cutoff"));
-        for (const char* key : {"cutoff", "compositing", "slab_thickness"}) record["settings"].erase(key);
+        for (const char* key : {"cutoff", "compositing", "slab_thickness", "lod_coarse"}) record["settings"].erase(key);
         spit(json, record.dump(2));
         const auto frameTime = fs::last_write_time(dir + "/frame_0000.png");
         test::expectOneLineError(animate(args + " --resume"), "older vdbsplat");

@@ -189,14 +189,14 @@ TEST_F(StudyCli, ResumeKeepsRendersAndRedoesOnlyWhatIsMissingOrChanged) {
     EXPECT_NE(png.out.find("(0 rendered, 6 kept)"), std::string::npos) << png.out;
     EXPECT_EQ(readImage(viewDir + "/point.png").width, 48);
 
-    // A render whose record an older build wrote (no cutoff, compositing or slab thickness in its
-    // identity: they were left out at their defaults, and --cutoff's default was 1e-4 then) is
+    // A render whose record an older build wrote (no cutoff, compositing, slab thickness or second
+    // --lod cap in its identity: they were left out at their defaults, and --cutoff's was 1e-4) is
     // rendered again, not kept: its fingerprint is not today's.
     {
         nlohmann::json side = nlohmann::json::parse(slurp(viewDir + "/hybrid.json"));
         nlohmann::json identity = side.at("made_from");
         ASSERT_TRUE(identity.at("settings").contains("cutoff"));
-        for (const char* key : {"cutoff", "compositing", "slab_thickness"}) identity["settings"].erase(key);
+        for (const char* key : {"cutoff", "compositing", "slab_thickness", "lod_coarse"}) identity["settings"].erase(key);
         side["made_from"] = identity;
         side["fingerprint"] = study::fnv1a(identity.dump());
         spit(viewDir + "/hybrid.json", side.dump(2));
