@@ -135,8 +135,11 @@ struct RenderSettings {
     /// `--lod PX,PX2`: PX2, the cap for 4³ and 8³ cells in still images (StreamOptions::
     /// lodCoarseCellPx); 0 (the default): lodPx for every level.
     double lodCoarsePx = 0.0;
-    /// The second cap in effect: lodCoarsePx where it is above lodPx, else lodPx.
-    double effectiveLodCoarsePx() const { return lodPx > 0.0 && lodCoarsePx > lodPx ? lodCoarsePx : lodPx; }
+    /// The second cap in effect: lodCoarsePx where it is above lodPx and the levels do not blend
+    /// their first passage (a blended zoom ignores it), else lodPx.
+    double effectiveLodCoarsePx() const {
+        return lodPx > 0.0 && lodCoarsePx > lodPx && effectiveLodBlend() != LodBlend::On ? lodCoarsePx : lodPx;
+    }
     /// How blocks pass from one level of detail to the next (volume/stream.h LodBlend, kLodPassage):
     /// On, blended as the camera moves (no pop in a zoom); Off, each block switches at once where a
     /// level becomes admissible; Still, the first passage (voxels → 2³) switches, the later blend.

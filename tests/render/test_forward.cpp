@@ -504,7 +504,9 @@ TEST(Forward, SecondLevelOfDetailCapCoarsensOnlyPastTheFirstPassage) {
     double sa = 0.0, sb = 0.0;
     for (size_t i = 0; i < a.pixels.size(); ++i) sa += a.pixels[i].w, sb += b.pixels[i].w;
     EXPECT_NEAR(sb / sa, 1.0, 1e-4);
+    EXPECT_EQ(s.toJson().value("lod_coarse", 0.0), 1.5);  // the settings JSON records it where it applies
     s.lodBlend = LodBlend::On;
+    EXPECT_FALSE(s.toJson().contains("lod_coarse"));
     const Image blended1 = renderWith(marschnerLobb(), thin, s);
     s.lodCoarsePx = 0.0;
     const Image blended0 = renderWith(marschnerLobb(), thin, s);
