@@ -228,9 +228,7 @@ RenderSettings settingsFromFlags(const Args& args) {
     if (auto v = args.get("--lod")) {
         const size_t comma = v->find(',');
         s.lodPx = parseDouble(v->substr(0, comma), "--lod");
-        s.lodCoarsePx = comma == std::string::npos ? 0.0 : parseDouble(v->substr(comma + 1), "--lod");
-        if (comma != std::string::npos && !(s.lodCoarsePx > 0.0))
-            throw Error("--lod: the second cap (PX,PX2) must be a number of pixels in [PX, 64]");
+        s.lodCoarsePx = comma == std::string::npos ? 0.0 : parseDouble(v->substr(comma + 1), "--lod");  // validate() checks it
     }
     if (auto v = args.get("--lod-blend")) s.lodBlend = parseLodBlend(*v);
     if (auto v = args.get("--compositing")) s.compositing = parseCompositingOrder(*v);

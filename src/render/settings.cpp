@@ -119,7 +119,14 @@ std::string toString(LodBlend blend) {
 
 std::string toString(CompositingOrder order) { return order == CompositingOrder::Slabs ? "slabs" : "kernels"; }
 
-nlohmann::json RenderSettings::toJson() const {
+namespace {
+/// RenderSettings::toJson (@p everyDefault false) and identityJson (true): the settings that older
+/// outputs left out at their defaults (RenderSettings::kIdentityOnlyKeys) are written always, or
+/// only away from their defaults; the one place each key's rule is written.
+nlohmann::json settingsJson(const RenderSettings& s, bool everyDefault) {
+    const RenderMode mode = s.mode;
+    const auto& camera = s.camera;
+    const bool forward = mode != RenderMode::Reference;  // the reference has no cutoff, slabs or levels
     nlohmann::json j;
     j["mode"] = toString(mode);
     j["width"] = camera.width;
@@ -136,44 +143,38 @@ nlohmann::json RenderSettings::toJson() const {
             j["up"] = {camera.up.x, camera.up.y, camera.up.z};
         }
     }
-    j["tf"] = transferFunction;
-    j["grid"] = gridName;
-    j["spp"] = spp;
-    j["threshold"] = threshold;
-    if (cutoff != kDefaultCutoff && mode != RenderMode::Reference) j["cutoff"] = cutoff;  // absent at the default: outputs unchanged
-    j["footprint"] = toString(footprint);
-    j["kernel"] = kernel;
+    j["tf"] = s.transferFunction;
+    j["grid"] = s.gridName;
+    j["spp"] = s.spp;
+    j["threshold"] = s.threshold;
+    if (forward && (everyDefault || s.cutoff != kDefaultCutoff)) j["cutoff"] = s.cutoff;
+    j["footprint"] = toString(s.footprint);
+    j["kernel"] = s.kernel;
     // Ewa and Swan filter each primitive, None filters nothing (RenderMode): echo what was used.
-    j["filter_order"] = mode == RenderMode::None ? "none" : modeFixesFilterOrder(mode) ? "prefilter" : toString(filterOrder);
+    j["filter_order"] = mode == RenderMode::None ? "none" : modeFixesFilterOrder(mode) ? "prefilter" : toString(s.filterOrder);
     // "auto" only where nothing resolved it for a view (render.h resolvedFor does).
     if (modeFixesFilterOrder(mode)) j["subpixels"] = 1;
-    else if (subpixels == kAutoSubpixels) j["subpixels"] = "auto";
-    else j["subpixels"] = subpixels;
-    j["show_primitives"] = showPrimitives;
-    j["lod"] = mode == RenderMode::None ? 0.0 : lodPx;
-    if (mode != RenderMode::None && mode != RenderMode::Reference && effectiveLodCoarsePx() > lodPx)
-        j["lod_coarse"] = effectiveLodCoarsePx();  // absent with one cap: outputs unchanged
-    if (mode != RenderMode::Reference && mode != RenderMode::None) j["lod_blend"] = toString(effectiveLodBlend());
-    if (effectiveCompositing() != CompositingOrder::Kernels && mode != RenderMode::Reference)
-        j["compositing"] = toString(effectiveCompositing());  // absent for kernels: unshaded outputs unchanged
-    if (effectiveSlabThickness() != 1.0 && mode != RenderMode::Reference) j["slab_thickness"] = effectiveSlabThickness();
-    j["simd"] = simd;
-    j["tables"] = tablesDir;  // "": the shipped tables (or built in memory where absent)
-    if (shading.active()) j["shading"] = shading.toJson();  // absent when off: unshaded outputs unchanged
-    if (emission.active()) j["emission"] = emission.toJson();  // likewise
+    else if (s.subpixels == kAutoSubpixels) j["subpixels"] = "auto";
+    else j["subpixels"] = s.subpixels;
+    j["show_primitives"] = s.showPrimitives;
+    j["lod"] = mode == RenderMode::None ? 0.0 : s.lodPx;
+    const double lodCoarse = mode == RenderMode::None ? 0.0 : s.effectiveLodCoarsePx();
+    if (forward && (everyDefault || lodCoarse > s.lodPx)) j["lod_coarse"] = lodCoarse;  // one cap: absent
+    if (forward && mode != RenderMode::None) j["lod_blend"] = toString(s.effectiveLodBlend());
+    const CompositingOrder order = s.effectiveCompositing();
+    if (forward && (everyDefault || order != CompositingOrder::Kernels)) j["compositing"] = toString(order);
+    if (forward && (everyDefault || s.effectiveSlabThickness() != 1.0)) j["slab_thickness"] = s.effectiveSlabThickness();
+    j["simd"] = s.simd;
+    j["tables"] = s.tablesDir;  // "": the shipped tables (or built in memory where absent)
+    if (s.shading.active()) j["shading"] = s.shading.toJson();  // absent when off: unshaded outputs unchanged
+    if (s.emission.active()) j["emission"] = s.emission.toJson();  // likewise
     return j;
 }
+}  // namespace
 
-nlohmann::json RenderSettings::identityJson() const {
-    nlohmann::json j = toJson();
-    if (mode != RenderMode::Reference) {
-        j["cutoff"] = cutoff;  // kIdentityOnlyKeys, in order
-        j["compositing"] = toString(effectiveCompositing());
-        j["slab_thickness"] = effectiveSlabThickness();
-        j["lod_coarse"] = mode == RenderMode::None ? 0.0 : effectiveLodCoarsePx();
-    }
-    return j;
-}
+nlohmann::json RenderSettings::toJson() const { return settingsJson(*this, false); }
+
+nlohmann::json RenderSettings::identityJson() const { return settingsJson(*this, true); }
 
 nlohmann::json RenderStats::toJson() const {
     nlohmann::json j;
