@@ -4,8 +4,8 @@
 // the previous process freed a moment ago are cheap, ones the guest handed back to the host are not
 // ("warm" and "cold" in docs/performance.md, session 29); the optional argument is the block's
 // size in MiB (default 8; 40 asks for 20 huge pages, more than a previous run freed). The
-// populated pages are also touched afterwards, twice: whether a populate spares the first touch's
-// cost on this host (on session 42's it did not). Not part
+// populated pages are also touched afterwards, twice: how much of the first touch's cost a
+// populate spares on this host (on session 42's, about half). Not part
 // of the build:
 //   g++ -O2 -pthread -o /tmp/fault-cost scripts/fault-cost.cpp && /tmp/fault-cost; sleep 5; /tmp/fault-cost 40
 #include <sys/mman.h>
@@ -62,9 +62,9 @@ int main(int argc, char** argv) {
     t = Clock::now();
     const int rc = madvise(p, bytes, MADV_POPULATE_WRITE);
     const double populate = msSince(t);
-    // The same pages touched after they were populated, then once more: on a host that backs a
-    // guest's page tables lazily (a PVM guest: session 42) the first touch after the populate
-    // still costs what a fault does, so populating saves nothing; the second touch is free.
+    // The same pages touched after they were populated, then once more: on a host that maps a
+    // guest's pages at their first touch (a PVM guest: session 42) the first touch after the
+    // populate still costs about half a fault; the second touch is free.
     t = Clock::now();
     touch(p, bytes);
     const double afterPopulate = msSince(t);
