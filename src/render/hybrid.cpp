@@ -111,17 +111,17 @@ Image composite(const Volume& volume, const ClassificationTable& table, const Ca
     if (slabs.on) ctx.marginal = &marginal.emplace(*tables.kernel);
     const auto hidden = [&](int x0, int y0, int x1, int y1) { return compositor.hidden(x0, y0, x1, y1); };
     const auto partlyHidden = [&](int x0, int y0, int x1, int y1) { return compositor.partlyHidden(x0, y0, x1, y1); };
-    VoxelBatch& batch = buffers.batch;
+    StreamWindow& voxels = buffers.voxels;
     ProjectedWindow& window = buffers.window;
     uint64_t drawnVoxels = 0;
     while (true) {
         if (control.stop && control.stop()) throw RenderStopped("render stopped");
         if (control.progress) control.progress(stream.progress());
         auto t = Clock::now();
-        if (!stream.next(batch, hidden, partlyHidden)) break;
+        if (!stream.next(voxels, hidden, partlyHidden)) break;
         stats.streamSeconds += since(t);
         t = Clock::now();
-        const ProjectionCounts counts = projectBatch(batch, ctx, window);
+        const ProjectionCounts counts = projectWindow(voxels, ctx, window);
         stats.points += counts.points, stats.splats += counts.splats;
         stats.exactIndexSplats += counts.exactIndexSplats;
         stats.lodAggregates += counts.lodAggregates, stats.lodVoxels += counts.lodVoxels;

@@ -139,10 +139,36 @@ Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, double lowPass, c
     return p;
 }
 
+/// Up to kSplatLanes consecutive voxels of a window, copied out of the stream's chunks where it
+/// extracted them (StreamWindow) into one thread's scratch, in the runs the window takes of each.
+struct LaneVoxels {
+    std::array<glm::vec3, kSplatLanes> viewPos, color;
+    std::array<float, kSplatLanes> distance, sigma, spread, depthSpread;
+    std::array<uint32_t, kSplatLanes> members;
+    bool withDepthSpread = false;
+    size_t n = 0;
+    /// Records [@p i, @p i + @p m) of @p batch appended (m ≤ kSplatLanes − n). Record by record:
+    /// the runs a window takes of a block that straddles its edge are a few records long, and a
+    /// library copy per array per run cost more than the records (docs/performance.md, session 43).
+    void append(const VoxelBatch& batch, size_t i, size_t m) {
+        const glm::vec3* p = batch.viewPos.data() + i;
+        const glm::vec3* c = batch.color.data() + i;
+        const float *d = batch.distance.data() + i, *s = batch.sigma.data() + i, *sp = batch.spread.data() + i;
+        const uint32_t* mb = batch.members.data() + i;
+        for (size_t q = 0; q < m; ++q) {
+            viewPos[n + q] = p[q], color[n + q] = c[q];
+            distance[n + q] = d[q], sigma[n + q] = s[q], spread[n + q] = sp[q], members[n + q] = mb[q];
+        }
+        if (withDepthSpread)
+            for (size_t q = 0; q < m; ++q) depthSpread[n + q] = batch.depthSpread[i + q];
+        n += m;
+    }
+};
+
 /// makeSplat's splat from lane @p k of a projectSplatsVector call, stored straight into
 /// @p window as primitive @p i (the fields set() would write from that Primitive; no Primitive
 /// is built). Returns its kind (Culled when it has no pixel on the image) and sets @p range.
-PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const VoxelBatch& batch, int64_t slab,
+PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const LaneVoxels& batch, int64_t slab,
                              const ProjectionContext& ctx, ProjectedWindow& window, PixelRange& range) {
     const uint8_t status = lanes.status[k];
     PrimitiveRecord& q = window.records[i];
@@ -153,22 +179,22 @@ PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const 
     q.hasExactMap = (status & SplatLanes::kExactIndex) != 0;  // as makeSplat: kept when culled
     q.centre = glm::vec2(float(lanes.centreX[k]), float(lanes.centreY[k]));
     q.shape = glm::vec3(float(lanes.conicXX[k]), float(lanes.conicXY[k]), float(lanes.conicYY[k]));
-    q.scale = float(batch.sigma[i] * lanes.amplitude[k]);
+    q.scale = float(batch.sigma[k] * lanes.amplitude[k]);
     q.sin2Alpha = float(lanes.sinAlpha[k] * lanes.sinAlpha[k]);
-    q.color = ctx.showPrimitives ? splatTint(batch.color[i]) : batch.color[i];
+    q.color = ctx.showPrimitives ? splatTint(batch.color[k]) : batch.color[k];
     q.range = range = lanes.range(k);
-    window.place(i, slab, batch.distance[i], batch.members[i], kind, range);
+    window.place(i, slab, batch.distance[k], batch.members[k], kind, range);
     if (kind == PrimitiveKind::SplatExactIndex) {  // in place (SplatLanes::exactMapInto)
         PrimitiveExtra& extra = window.extra[i];
         lanes.exactMapInto(k, extra.exactMap);
-        extra.viewPos = batch.viewPos[i], extra.sigma = batch.sigma[i];
+        extra.viewPos = batch.viewPos[k], extra.sigma = batch.sigma[k];
     }
     return kind;
 }
 
 /// makePoint's point, set up as setUpPointFilter does, from lane @p k of a projectPointsVector
 /// call, stored straight into @p window as primitive @p i (as storeLaneSplat); sets @p range.
-void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const VoxelBatch& batch, int64_t slab,
+void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const LaneVoxels& batch, int64_t slab,
                     const ProjectionContext& ctx, ProjectedWindow& window, PixelRange& range) {
     PrimitiveRecord& q = window.records[i];
     q.kind = PrimitiveKind::Point;
@@ -177,25 +203,26 @@ void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const VoxelBatc
     q.shape = glm::vec3(lanes.invVariance[k], lanes.total[k], lanes.norm[k]);
     q.scale = lanes.radius2[k];
     q.sin2Alpha = 0.f;
-    q.color = batch.color[i];  // points are never tinted
+    q.color = batch.color[k];  // points are never tinted
     q.range = range = lanes.range(k, ctx.camera.width(), ctx.camera.height());
-    window.place(i, slab, batch.distance[i], batch.members[i], PrimitiveKind::Point, range);
+    window.place(i, slab, batch.distance[k], batch.members[k], PrimitiveKind::Point, range);
 }
 
-/// Voxels [@p first, @p first + @p n) of @p batch (n ≤ kSplatLanes) into the lanes, and projected
-/// there as splats and as points where those contexts apply; the lanes past n hold zeros.
-void projectChunkInLanes(const VoxelBatch& batch, size_t first, size_t n, const std::optional<SplatLaneContext>& splats,
+/// The voxels of @p group (n ≤ kSplatLanes) into the lanes, and projected there as splats and as
+/// points where those contexts apply; the lanes past n hold zeros.
+void projectChunkInLanes(const LaneVoxels& group, const std::optional<SplatLaneContext>& splats,
                          const std::optional<PointLaneContext>& pointsIn, SplatLanes& lanes, PointLanes& points) {
     if (!splats && !pointsIn) return;
+    const size_t n = group.n;
     for (size_t k = 0; k < n; ++k) {
-        const glm::vec3& c = batch.viewPos[first + k];
+        const glm::vec3& c = group.viewPos[k];
         lanes.x[k] = c.x, lanes.y[k] = c.y, lanes.z[k] = c.z;
     }
     for (size_t k = n; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
     if (splats) projectSplatsVector(lanes, n, *splats);
     if (!pointsIn) return;
-    std::copy_n(batch.sigma.data() + first, n, points.sigma);
-    std::copy_n(batch.spread.data() + first, n, points.spread);
+    std::copy_n(group.sigma.data(), n, points.sigma);
+    std::copy_n(group.spread.data(), n, points.spread);
     std::fill(points.sigma + n, points.sigma + kSplatLanes, 0.f);
     std::fill(points.spread + n, points.spread + kSplatLanes, 0.f);
     projectPointsVector(lanes, points, n, *pointsIn);
@@ -314,67 +341,93 @@ std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx) {
 }
 
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window) {
-    window.slabBase = batch.slabBegin;
-    window.slabEnd = batch.slabEnd;
+    return projectWindow(StreamWindow::of(batch), ctx, window);
+}
+
+ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionContext& ctx, ProjectedWindow& window) {
+    window.slabBase = voxels.slabBegin;
+    window.slabEnd = voxels.slabEnd;
     window.profiles = ctx.slabs.on;
-    window.resize(batch.size());
+    window.resize(voxels.size);
     const std::optional<SplatLaneContext> laneContext = splatLaneContext(ctx);
     // Points in lanes too (hybrid and point mode): the far views' and the clouds' voxels.
     const std::optional<PointLaneContext> pointContext = pointLaneContext(ctx);
     return tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, batch.size(), 1024), ProjectionCounts{},
+        tbb::blocked_range<size_t>(0, voxels.sources.size(), 2), ProjectionCounts{},
         [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
             SplatLanes lanes;
             PointLanes points;
-            std::array<int64_t, kSplatLanes> slabs;  // of voxels [chunk, chunkEnd)
-            PendingProfiles profiles;                // --compositing slabs: the chunk's, in vectors
-            size_t chunk = r.begin(), chunkEnd = r.begin();  // the voxels of the current chunk
-            for (size_t i = r.begin(); i < r.end(); ++i) {
-                if (i == chunkEnd) {  // the next kSplatLanes voxels: their slabs, and their splats projected at once
-                    profiles.flush(ctx.marginal, ctx.slabs.reach, window);
-                    chunk = i, chunkEnd = std::min(r.end(), i + kSplatLanes);
-                    slabsOf(batch.distance.data() + chunk, chunkEnd - chunk, ctx.slabLength, batch.slabBegin,
-                            batch.slabEnd - 1, slabs.data());
-                    projectChunkInLanes(batch, chunk, chunkEnd - chunk, laneContext, pointContext, lanes, points);
+            std::array<int64_t, kSplatLanes> slabs;  // of the group's voxels
+            PendingProfiles profiles;                // --compositing slabs: the group's, in vectors
+            LaneVoxels group;
+            // The range's sources take consecutive primitives of the window, from its first's first.
+            size_t next = voxels.sources[r.begin()].first;
+            // The group's voxels projected at once (their slabs, splats and points), then each stored
+            // as the window's next primitive.
+            const auto project = [&] {
+                const LaneVoxels& batch = group;
+                if (batch.n == 0) return;
+                profiles.flush(ctx.marginal, ctx.slabs.reach, window);
+                slabsOf(batch.distance.data(), batch.n, ctx.slabLength, voxels.slabBegin, voxels.slabEnd - 1, slabs.data());
+                projectChunkInLanes(batch, laneContext, pointContext, lanes, points);
+                for (size_t k = 0; k < batch.n; ++k) {
+                    const size_t i = next++;
+                    const int64_t slab = slabs[k];  // clamp(⌊distance / slabLength⌋, the window's slabs)
+                    PrimitiveKind kind;
+                    PixelRange range;
+                    if (laneContext && lanes.status[k] != SplatLanes::kScalar) {
+                        kind = storeLaneSplat(lanes, k, i, batch, slab, ctx, window, range);
+                    } else if (pointContext && points.status[k] == PointLanes::kPoint) {
+                        storeLanePoint(points, k, i, batch, slab, ctx, window, range);
+                        kind = PrimitiveKind::Point;
+                    } else {
+                        Primitive p = projectVoxel(glm::dvec3(batch.viewPos[k]), batch.sigma[k], batch.color[k], ctx, batch.spread[k]);
+                        p.members = batch.members[k];
+                        p.depth = batch.distance[k];
+                        p.slab = slab;
+                        window.set(i, p);  // its profile below (set() writes p's default one first)
+                        kind = p.kind, range = p.range;
+                    }
+                    if (kind == PrimitiveKind::Culled) continue;
+                    const uint32_t members = batch.members[k];
+                    ++(kind == PrimitiveKind::Point ? c.points : c.splats);
+                    if (kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
+                    c.drawnVoxels += members;
+                    if (members > 1) ++c.lodAggregates, c.lodVoxels += members;
+                    if (ctx.occlusion && !range.empty() && ctx.occlusion->hidden(range.x0, range.y0, range.x1, range.y1)) {
+                        window.order[i] = ProjectedWindow::kNotDrawn;  // never binned: its profile is never read
+                        ++(kind == PrimitiveKind::Point ? c.hidden.points : c.hidden.splats);
+                        if (kind == PrimitiveKind::SplatExactIndex) ++c.hidden.exactIndexSplats;
+                        c.hidden.voxels += members;
+                        continue;
+                    }
+                    if (ctx.slabs.on) {
+                        const glm::dvec3 v(batch.viewPos[k]);
+                        const float depthSpread = batch.withDepthSpread ? batch.depthSpread[k] : 0.f;
+                        if (ctx.vector && ctx.marginal)
+                            profiles.add(i, slabProfileInput(v, batch.distance[k], slab, depthSpread, ctx));
+                        else
+                            window.profile[i] = slabProfileFor(v, batch.distance[k], slab, depthSpread, ctx);
+                    }
                 }
-                const int64_t slab = slabs[i - chunk];  // clamp(⌊distance / slabLength⌋, the batch's slabs)
-                PrimitiveKind kind;
-                PixelRange range;
-                if (laneContext && lanes.status[i - chunk] != SplatLanes::kScalar) {
-                    kind = storeLaneSplat(lanes, i - chunk, i, batch, slab, ctx, window, range);
-                } else if (pointContext && points.status[i - chunk] == PointLanes::kPoint) {
-                    storeLanePoint(points, i - chunk, i, batch, slab, ctx, window, range);
-                    kind = PrimitiveKind::Point;
-                } else {
-                    Primitive p = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
-                    p.members = batch.members[i];
-                    p.depth = batch.distance[i];
-                    p.slab = slab;
-                    window.set(i, p);  // its profile below (set() writes p's default one first)
-                    kind = p.kind, range = p.range;
-                }
-                if (kind == PrimitiveKind::Culled) continue;
-                const uint32_t members = batch.members[i];
-                ++(kind == PrimitiveKind::Point ? c.points : c.splats);
-                if (kind == PrimitiveKind::SplatExactIndex) ++c.exactIndexSplats;
-                c.drawnVoxels += members;
-                if (members > 1) ++c.lodAggregates, c.lodVoxels += members;
-                if (ctx.occlusion && !range.empty() && ctx.occlusion->hidden(range.x0, range.y0, range.x1, range.y1)) {
-                    window.order[i] = ProjectedWindow::kNotDrawn;  // never binned: its profile is never read
-                    ++(kind == PrimitiveKind::Point ? c.hidden.points : c.hidden.splats);
-                    if (kind == PrimitiveKind::SplatExactIndex) ++c.hidden.exactIndexSplats;
-                    c.hidden.voxels += members;
-                    continue;
-                }
-                if (ctx.slabs.on) {
-                    const glm::dvec3 c(batch.viewPos[i]);
-                    const float depthSpread = batch.depthSpread.empty() ? 0.f : batch.depthSpread[i];
-                    if (ctx.vector && ctx.marginal)
-                        profiles.add(i, slabProfileInput(c, batch.distance[i], slab, depthSpread, ctx));
-                    else
-                        window.profile[i] = slabProfileFor(c, batch.distance[i], slab, depthSpread, ctx);
-                }
+            };
+            const auto flushGroup = [&] {
+                project();
+                group.n = 0;
+            };
+            for (size_t s = r.begin(); s < r.end(); ++s) {
+                const WindowSource& src = voxels.sources[s];
+                group.withDepthSpread = !src.records->depthSpread.empty();
+                src.forEachRun(voxels.limit, [&](size_t i, size_t m) {
+                    while (m > 0) {
+                        const size_t take = std::min(m, kSplatLanes - group.n);
+                        group.append(*src.records, i, take);
+                        i += take, m -= take;
+                        if (group.n == kSplatLanes) flushGroup();
+                    }
+                });
             }
+            flushGroup();
             profiles.flush(ctx.marginal, ctx.slabs.reach, window);
             return c;
         },

@@ -95,6 +95,10 @@ std::optional<PointLaneContext> pointLaneContext(const ProjectionContext& ctx);
 /// batch's first slab. @return what the primitives draw, by kind.
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window);
 
+/// @brief projectBatch for a window read where the stream extracted it (StreamWindow): primitive
+/// k from the window's voxel k. The same primitives as projectBatch of the window copied out.
+ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionContext& ctx, ProjectedWindow& window);
+
 /// @brief --compositing slabs: the slab fractions of a primitive at view position @p c, distance
 /// @p distance, in slab @p slab, whose kernel is @p ctx's (a sphere of h, or ctx.shape's ellipsoid)
 /// widened along the view ray by an aggregate's second moment @p depthSpread (world²): its

@@ -1,0 +1,115 @@
+// tests/render/test_project_window.cpp — projectWindow, the projection of a window read where the
+// stream extracted it (StreamWindow: runs of the extraction chunks, no copy), against its slow,
+// obvious form: the window copied out into one VoxelBatch (StreamWindow::copyTo) and projected by
+// projectBatch. Every primitive must be the same, bit for bit, in every window of a stream whose
+// blocks straddle the windows' edges (so that sources are taken in part, window after window).
+#include <gtest/gtest.h>
+
+#include "camera/camera.h"
+#include "render/project.h"
+#include "support/projection.h"
+#include "volume/generate.h"
+#include "volume/stream.h"
+
+namespace vdbsplat {
+namespace {
+
+void expectSameWindow(const ProjectedWindow& a, const ProjectedWindow& b) {
+    ASSERT_EQ(a.size, b.size);
+    ASSERT_EQ(a.slabBase, b.slabBase);
+    ASSERT_EQ(a.slabEnd, b.slabEnd);
+    for (size_t i = 0; i < a.size; ++i) {
+        ASSERT_EQ(a.order[i], b.order[i]) << i;
+        ASSERT_EQ(a.depth[i], b.depth[i]) << i;
+        ASSERT_EQ(a.members[i], b.members[i]) << i;
+        if (a.order[i] == ProjectedWindow::kNotDrawn) continue;
+        const PrimitiveRecord &p = a.records[i], &q = b.records[i];
+        ASSERT_EQ(p.kind, q.kind) << i;
+        ASSERT_EQ(p.centre, q.centre) << i;
+        ASSERT_EQ(p.shape, q.shape) << i;
+        ASSERT_EQ(p.scale, q.scale) << i;
+        ASSERT_EQ(p.sin2Alpha, q.sin2Alpha) << i;
+        ASSERT_EQ(p.color, q.color) << i;
+        ASSERT_EQ(p.slab, q.slab) << i;
+        ASSERT_TRUE(p.range.x0 == q.range.x0 && p.range.y0 == q.range.y0 && p.range.x1 == q.range.x1 &&
+                    p.range.y1 == q.range.y1) << i;
+        ASSERT_EQ(a.tiles[i], b.tiles[i]) << i;
+        ASSERT_EQ(p.hasExactMap, q.hasExactMap) << i;
+        if (p.hasExactMap) {
+            ASSERT_TRUE(a.extra[i].exactMap == b.extra[i].exactMap) << i;
+        }
+    }
+}
+
+struct Case {
+    const char* name;
+    double distance;  ///< of the framing distance: 1 framed (splats), 2.5 and 6 farther (points, aggregates)
+    RenderMode mode;
+    bool vector;
+    double lodCellPx = 1.0;  ///< StreamOptions::lodCellPx (0: every voxel its own record)
+};
+
+class ProjectWindow : public ::testing::TestWithParam<Case> {};
+
+TEST_P(ProjectWindow, EqualsTheWindowCopiedOutAndProjected) {
+    const Case c = GetParam();
+    static const Volume v = makeVolume(makeCloud(150000, 11), "cloud");
+    glm::dvec3 lo, hi;
+    v.worldBounds(lo, hi);
+    CameraSpec spec;
+    spec.width = spec.height = 96;
+    spec.distance = c.distance;
+    const Camera camera = makeCamera(spec, lo, hi);
+    const ClassificationTable table(std::vector<Classified>(ClassificationTable::kSize, Classified{glm::vec3(0.8f, 0.5f, 0.2f), 0.3f}),
+                                    0.f, 1.f);
+    StreamOptions options;
+    // Many windows, many blocks across their edges.
+    options.minWindowVoxels = 512, options.maxWindowVoxels = 8192, options.slabsPerWindow = 4;
+    options.pointBelowPx = c.mode == RenderMode::Point ? INFINITY : 1.0;
+    options.lodCellPx = c.lodCellPx;
+    VoxelStream stream(v, camera, table, options);
+    ProjectionContext ctx{camera, test::sharedTables(), v.voxelSize, stream.slabLength(), c.mode, 1.0, FootprintPath::Auto, false};
+    ctx.vector = c.vector;
+    StreamWindow window;
+    VoxelBatch copied;
+    ProjectedWindow inPlace, fromCopy;
+    size_t windows = 0, partSources = 0, records = 0, aggregates = 0;
+    while (stream.next(window)) {
+        ++windows;
+        size_t taken = 0;
+        for (const WindowSource& s : window.sources) {
+            ASSERT_EQ(s.first, taken);
+            taken += s.count;
+            partSources += s.whole ? 0 : 1;
+        }
+        ASSERT_EQ(taken, window.size);
+        window.copyTo(copied, false);
+        ASSERT_EQ(copied.size(), window.size);
+        const ProjectionCounts a = projectWindow(window, ctx, inPlace);
+        const ProjectionCounts b = projectBatch(copied, ctx, fromCopy);
+        EXPECT_EQ(a.points, b.points);
+        EXPECT_EQ(a.splats, b.splats);
+        EXPECT_EQ(a.drawnVoxels, b.drawnVoxels);
+        EXPECT_EQ(a.lodAggregates, b.lodAggregates);
+        aggregates += a.lodAggregates;
+        expectSameWindow(inPlace, fromCopy);
+        records += window.size;
+    }
+    EXPECT_GT(windows, 3u);
+    EXPECT_GT(partSources, 10u) << "no block was taken in part: the test does not reach the filtered runs";
+    EXPECT_GT(records, 1000u);
+    if (c.lodCellPx > 0.0 && c.distance > 2.0) {
+        EXPECT_GT(aggregates, 0u) << "no level-of-detail cell in the case meant for them";
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Views, ProjectWindow,
+                         ::testing::Values(Case{"framed_hybrid", 1.0, RenderMode::Hybrid, true},
+                                           Case{"framed_scalar", 1.0, RenderMode::Hybrid, false},
+                                           Case{"far_points", 6.0, RenderMode::Hybrid, true, 0.0},
+                                           Case{"aggregates", 2.5, RenderMode::Hybrid, true, 1.0},
+                                           Case{"framed_points", 1.0, RenderMode::Point, true}),
+                         [](const ::testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
+
+}  // namespace
+}  // namespace vdbsplat
