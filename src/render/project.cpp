@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <optional>
@@ -165,10 +166,28 @@ struct LaneVoxels {
     }
 };
 
+/// kSplatLanes or fewer consecutive voxels of a window as the projection reads them: a run of a
+/// buffer's records where they lie (LaneView::in), or a LaneVoxels scratch that gathered the
+/// ends of several runs (LaneView::of).
+struct LaneView {
+    const glm::vec3 *viewPos, *color;
+    const float *distance, *sigma, *spread, *depthSpread;  ///< depthSpread: null without
+    const uint32_t* members;
+    size_t n;
+    static LaneView in(const VoxelBatch& b, size_t i, size_t n) {
+        return {b.viewPos.data() + i, b.color.data() + i, b.distance.data() + i, b.sigma.data() + i, b.spread.data() + i,
+                b.depthSpread.empty() ? nullptr : b.depthSpread.data() + i, b.members.data() + i, n};
+    }
+    static LaneView of(const LaneVoxels& g) {
+        return {g.viewPos.data(), g.color.data(), g.distance.data(), g.sigma.data(), g.spread.data(),
+                g.withDepthSpread ? g.depthSpread.data() : nullptr, g.members.data(), g.n};
+    }
+};
+
 /// makeSplat's splat from lane @p k of a projectSplatsVector call, stored straight into
 /// @p window as primitive @p i (the fields set() would write from that Primitive; no Primitive
 /// is built). Returns its kind (Culled when it has no pixel on the image) and sets @p range.
-PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const LaneVoxels& batch, int64_t slab,
+PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const LaneView& batch, int64_t slab,
                              const ProjectionContext& ctx, ProjectedWindow& window, PixelRange& range) {
     const uint8_t status = lanes.status[k];
     PrimitiveRecord& q = window.records[i];
@@ -194,7 +213,7 @@ PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const 
 
 /// makePoint's point, set up as setUpPointFilter does, from lane @p k of a projectPointsVector
 /// call, stored straight into @p window as primitive @p i (as storeLaneSplat); sets @p range.
-void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const LaneVoxels& batch, int64_t slab,
+void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const LaneView& batch, int64_t slab,
                     const ProjectionContext& ctx, ProjectedWindow& window, PixelRange& range) {
     PrimitiveRecord& q = window.records[i];
     q.kind = PrimitiveKind::Point;
@@ -210,7 +229,7 @@ void storeLanePoint(const PointLanes& lanes, size_t k, size_t i, const LaneVoxel
 
 /// The voxels of @p group (n ≤ kSplatLanes) into the lanes, and projected there as splats and as
 /// points where those contexts apply; the lanes past n hold zeros.
-void projectChunkInLanes(const LaneVoxels& group, const std::optional<SplatLaneContext>& splats,
+void projectChunkInLanes(const LaneView& group, const std::optional<SplatLaneContext>& splats,
                          const std::optional<PointLaneContext>& pointsIn, SplatLanes& lanes, PointLanes& points) {
     if (!splats && !pointsIn) return;
     const size_t n = group.n;
@@ -221,8 +240,8 @@ void projectChunkInLanes(const LaneVoxels& group, const std::optional<SplatLaneC
     for (size_t k = n; k < kSplatLanes; ++k) lanes.x[k] = lanes.y[k] = lanes.z[k] = 0.0;
     if (splats) projectSplatsVector(lanes, n, *splats);
     if (!pointsIn) return;
-    std::copy_n(group.sigma.data(), n, points.sigma);
-    std::copy_n(group.spread.data(), n, points.spread);
+    std::copy_n(group.sigma, n, points.sigma);
+    std::copy_n(group.spread, n, points.spread);
     std::fill(points.sigma + n, points.sigma + kSplatLanes, 0.f);
     std::fill(points.spread + n, points.spread + kSplatLanes, 0.f);
     projectPointsVector(lanes, points, n, *pointsIn);
@@ -353,22 +372,22 @@ ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionConte
     // Points in lanes too (hybrid and point mode): the far views' and the clouds' voxels.
     const std::optional<PointLaneContext> pointContext = pointLaneContext(ctx);
     return tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, voxels.sources.size(), 2), ProjectionCounts{},
+        tbb::blocked_range<size_t>(0, voxels.size, 1024), ProjectionCounts{},
         [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
             SplatLanes lanes;
             PointLanes points;
             std::array<int64_t, kSplatLanes> slabs;  // of the group's voxels
             PendingProfiles profiles;                // --compositing slabs: the group's, in vectors
             LaneVoxels group;
-            // The range's sources take consecutive primitives of the window, from its first's first.
-            size_t next = voxels.sources[r.begin()].first;
+            // Primitives [r.begin(), r.end()) of the window, from the run that holds the first on
+            // (split by records, as a batch was: the runs' sizes vary, 1 to 4 096).
+            size_t next = r.begin();
             // The group's voxels projected at once (their slabs, splats and points), then each stored
             // as the window's next primitive.
-            const auto project = [&] {
-                const LaneVoxels& batch = group;
+            const auto project = [&](const LaneView& batch) {
                 if (batch.n == 0) return;
                 profiles.flush(ctx.marginal, ctx.slabs.reach, window);
-                slabsOf(batch.distance.data(), batch.n, ctx.slabLength, voxels.slabBegin, voxels.slabEnd - 1, slabs.data());
+                slabsOf(batch.distance, batch.n, ctx.slabLength, voxels.slabBegin, voxels.slabEnd - 1, slabs.data());
                 projectChunkInLanes(batch, laneContext, pointContext, lanes, points);
                 for (size_t k = 0; k < batch.n; ++k) {
                     const size_t i = next++;
@@ -403,7 +422,7 @@ ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionConte
                     }
                     if (ctx.slabs.on) {
                         const glm::dvec3 v(batch.viewPos[k]);
-                        const float depthSpread = batch.withDepthSpread ? batch.depthSpread[k] : 0.f;
+                        const float depthSpread = batch.depthSpread ? batch.depthSpread[k] : 0.f;
                         if (ctx.vector && ctx.marginal)
                             profiles.add(i, slabProfileInput(v, batch.distance[k], slab, depthSpread, ctx));
                         else
@@ -412,20 +431,26 @@ ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionConte
                 }
             };
             const auto flushGroup = [&] {
-                project();
+                project(LaneView::of(group));
                 group.n = 0;
             };
-            for (size_t s = r.begin(); s < r.end(); ++s) {
-                const WindowSource& src = voxels.sources[s];
+            const auto after = [](size_t k, const WindowSource& run) { return k < run.first + run.count; };
+            for (auto run = std::upper_bound(voxels.sources.begin(), voxels.sources.end(), r.begin(), after);
+                 run != voxels.sources.end() && run->first < r.end(); ++run) {
+                const WindowSource& src = *run;
                 group.withDepthSpread = !src.records->depthSpread.empty();
-                src.forEachRun(voxels.limit, [&](size_t i, size_t m) {
-                    while (m > 0) {
-                        const size_t take = std::min(m, kSplatLanes - group.n);
-                        group.append(*src.records, i, take);
-                        i += take, m -= take;
-                        if (group.n == kSplatLanes) flushGroup();
+                const size_t from = std::max(r.begin(), src.first), to = std::min(r.end(), src.first + src.count);
+                for (size_t i = src.begin + (from - src.first), end = src.begin + (to - src.first); i < end;) {
+                    if (group.n == 0 && end - i >= kSplatLanes) {  // a whole lane group where it lies
+                        project(LaneView::in(*src.records, i, kSplatLanes));
+                        i += kSplatLanes;
+                        continue;
                     }
-                });
+                    const size_t take = std::min(end - i, kSplatLanes - group.n);
+                    group.append(*src.records, i, take);
+                    i += take;
+                    if (group.n == kSplatLanes) flushGroup();
+                }
             }
             flushGroup();
             profiles.flush(ctx.marginal, ctx.slabs.reach, window);

@@ -9,7 +9,6 @@
 #include <array>
 #include <bit>
 #include <cmath>
-#include <limits>
 #include <optional>
 #include <type_traits>
 
@@ -59,8 +58,9 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
                          StreamBuffers* buffers)
     : volume_(volume), camera_(camera), table_(table), options_(options), shader_(shader), emission_(emission),
       slabLength_(options.slabThickness * volume.voxelSize), own_(buffers ? nullptr : std::make_unique<StreamBuffers>()),
+      pending_(buffers ? buffers->pending : own_->pending), pendingNext_(buffers ? buffers->pendingNext : own_->pendingNext),
       extracted_(buffers ? buffers->extracted : own_->extracted), slabsPerWindow_(std::max(1, options.slabsPerWindow)) {
-    chunkUsers_.assign(extracted_.size(), 0);  // kept buffers: whatever a stopped render left, all free
+    pending_.clear();  // kept buffers: what a stopped render left
     if (volume.activeVoxels > kMaxActiveVoxels)
         throw Error(volume.file + ": grid '" + volume.name + "' has " + std::to_string(volume.activeVoxels) +
                     " active voxels, more than the 2^32 vdbsplat streams");
@@ -812,10 +812,7 @@ StreamWindow StreamWindow::of(const VoxelBatch& batch, size_t piece) {
     w.size = batch.size();
     w.slabBegin = batch.slabBegin, w.slabEnd = batch.slabEnd;
     piece = std::max<size_t>(piece, 1);
-    for (size_t i = 0; i < batch.size(); i += piece) {
-        const size_t n = std::min(piece, batch.size() - i);
-        w.sources.push_back({&batch, i, i + n, -INFINITY, true, i, n});
-    }
+    for (size_t i = 0; i < batch.size(); i += piece) w.sources.push_back({&batch, i, i, std::min(piece, batch.size() - i)});
     return w;
 }
 
@@ -825,86 +822,71 @@ void StreamWindow::copyTo(VoxelBatch& batch, bool depthSpread) const {
     batch.slabBegin = slabBegin, batch.slabEnd = slabEnd;
     const RecordArrays<VoxelBatch> to(batch);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, sources.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t s = r.begin(); s < r.end(); ++s) {
-            const WindowSource& src = sources[s];
-            const RecordArrays<const VoxelBatch> from(*src.records);
-            if (src.whole) {
-                to.copyRange(from, src.begin, src.first, src.end - src.begin);
-                continue;
-            }
-            size_t out = src.first;
-            src.forEachRun(limit, [&](size_t i, size_t n) {
-                to.copyRange(from, i, out, n);
-                out += n;
-            });
-        }
+        for (size_t s = r.begin(); s < r.end(); ++s)
+            to.copyRange(RecordArrays<const VoxelBatch>(*sources[s].records), sources[s].begin, sources[s].first, sources[s].count);
     });
 }
 
-// The sources, in order: the live blocks (activated by earlier windows, their records not under
-// the last window's limit still to come), then each new block. Each source's released (under the
-// new limit) and kept counts, then prefix sums: the window's records are each source's released
-// ones in order, read where they were extracted (no copy; the projection reads them there). That
-// is what appending every block's records in activation order and keeping those of each window's
-// range gives, so it does not depend on the thread count; and the same records, in the same order,
-// as the pending buffer of kept records copied window after window gave before session 43.
+// The sources, in order: the pending voxels in fixed chunks, then each new block's voxels. Each
+// source's released (distance < limit) and kept counts, prefix sums, then every source in parallel
+// copies its kept records to its offset in pending and, where it is taken only in part, moves its
+// released ones to its own front, in order (each source's records are its own, and rewritten only
+// at the next window: the chunks' at the next extraction, the pending ones, swapped out, at the
+// next release). The window reads each source's released records where they are. The same order
+// as a serial append-and-partition, so the windows do not depend on the thread count; and the
+// same records as the one batch they were all copied into before session 43.
 void VoxelStream::release(size_t blocks, float limit, StreamWindow& window) {
-    const size_t old = live_.size(), sources = old + blocks;
-    // Source s: its chunk, its records, and the limit its records are already released under.
-    const auto source = [&](size_t s, float& below) -> LiveBlock {
-        if (s < old) return below = releasedBelow_, live_[s];
-        const size_t j = s - old;
-        below = -std::numeric_limits<float>::infinity();
-        return {chunkSlot_[j / kExtractChunk], blockRecords_[j].first, blockRecords_[j].second};
+    constexpr size_t kChunk = 4096;
+    const size_t pendingChunks = (pending_.size() + kChunk - 1) / kChunk, sources = pendingChunks + blocks;
+    const auto source = [&](size_t s, size_t& begin, size_t& end) -> VoxelBatch& {
+        if (s < pendingChunks) {
+            begin = s * kChunk, end = std::min(pending_.size(), begin + kChunk);
+            return pending_;
+        }
+        const size_t block = s - pendingChunks;
+        begin = blockRecords_[block].first, end = blockRecords_[block].second;
+        return extracted_[block / kExtractChunk];
     };
-    // A record is still to come when it is not under `below` (a NaN distance never leaves, as it
-    // never left the pending buffer), and released now when it is also under the limit.
     std::vector<size_t> released(sources + 1, 0), kept(sources + 1, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, sources, 16), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t s = r.begin(); s < r.end(); ++s) {
-            float below;
-            const LiveBlock src = source(s, below);
-            const float* distance = extracted_[src.chunk].distance.data();
-            size_t n = 0, left = 0;
-            for (size_t i = src.begin; i < src.end; ++i) {
-                const bool toCome = !(distance[i] < below), now = distance[i] < limit;
-                n += toCome && now ? 1 : 0, left += toCome && !now ? 1 : 0;
+            size_t begin, end, n = 0;
+            const VoxelBatch& src = source(s, begin, end);
+            for (size_t i = begin; i < end; ++i) n += src.distance[i] < limit ? 1 : 0;
+            released[s + 1] = n, kept[s + 1] = (end - begin) - n;
+        }
+    });
+    for (size_t s = 0; s < sources; ++s) released[s + 1] += released[s], kept[s + 1] += kept[s];
+    pendingNext_.withDepthSpread = options_.depthSpread;
+    pendingNext_.resize(kept[sources]);
+    const RecordArrays<VoxelBatch> toPending(pendingNext_);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, sources, 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t s = r.begin(); s < r.end(); ++s) {
+            size_t begin, end, stay = kept[s];
+            if (kept[s + 1] == stay) continue;  // released whole: read where it is
+            VoxelBatch& batch = source(s, begin, end);
+            const RecordArrays<const VoxelBatch> src(batch);
+            // A source wholly kept is copied array by array: the same records in the same places.
+            if (kept[s + 1] - stay == end - begin) {
+                toPending.copyRange(src, begin, stay, end - begin);
+                continue;
             }
-            released[s + 1] = n, kept[s + 1] = left;
+            // Taken in part: record i is read before anything is written at or after it (front ≤ i).
+            const RecordArrays<VoxelBatch> own(batch);
+            size_t front = begin;
+            for (size_t i = begin; i < end; ++i)
+                src.distance[i] < limit ? own.copy(src, i, front++) : toPending.copy(src, i, stay++);
         }
     });
     window.sources.clear();
-    window.limit = limit;
-    // The blocks with records left stay live, in the same order; a chunk none of them is in is
-    // free once this window is projected (claimChunks, at the next window).
-    std::vector<LiveBlock> next;
-    next.reserve(sources);
-    size_t first = 0;
+    window.size = released[sources];
     for (size_t s = 0; s < sources; ++s) {
-        float below;
-        const LiveBlock src = source(s, below);
-        const size_t n = released[s + 1];
-        if (n > 0) window.sources.push_back({&extracted_[src.chunk], src.begin, src.end, below, n == src.end - src.begin, first, n});
-        first += n;
-        if (kept[s + 1] > 0) next.push_back(src);
-        else --chunkUsers_[src.chunk];
+        size_t begin, end;
+        const VoxelBatch& src = source(s, begin, end);
+        const size_t n = released[s + 1] - released[s];
+        if (n > 0) window.sources.push_back({s < pendingChunks ? &pendingNext_ : &src, begin, released[s], n});  // pending: swapped below
     }
-    window.size = first;
-    live_.swap(next);
-    unreleased_ = 0;
-    for (size_t s = 0; s < sources; ++s) unreleased_ += kept[s + 1];
-    releasedBelow_ = limit;
-}
-
-void VoxelStream::claimChunks(size_t chunks) {
-    chunkSlot_.clear();
-    for (uint32_t slot = 0; slot < chunkUsers_.size() && chunkSlot_.size() < chunks; ++slot)
-        if (chunkUsers_[slot] == 0) chunkSlot_.push_back(slot);
-    while (chunkSlot_.size() < chunks) {
-        chunkSlot_.push_back(uint32_t(extracted_.size()));
-        extracted_.emplace_back();
-        chunkUsers_.push_back(0);
-    }
+    std::swap(pending_, pendingNext_);
 }
 
 bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden,
@@ -918,8 +900,16 @@ bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int
 bool VoxelStream::next(StreamWindow& window, const std::function<bool(int, int, int, int)>& hidden,
                        const std::function<bool(int, int, int, int)>& partlyHidden) {
     window.sources.clear(), window.size = 0;
+    // Room for the largest windows' pending records at once: grown window by window, they were
+    // copied at every growth and took fresh pages each time (a one-shot render's most page
+    // faults). Reserved, nothing is touched until written; by the records the blocks give, not
+    // their voxels (room for a far view's voxels is huge pages it would touch for few).
+    if (records_ == 0)
+        for (const uint32_t k : order_) records_ += recordsOf(blocks_[k]);
+    const size_t room = std::min<size_t>(records_, 2 * options_.maxWindowVoxels);
+    if (pending_.viewPos.capacity() < room) pending_.reserve(room, options_.depthSpread), pendingNext_.reserve(room, options_.depthSpread);
     while (true) {
-        if (unreleased_ == 0) {
+        if (pending_.size() == 0) {
             if (nextBlock_ >= order_.size()) return false;
             // Skip empty depth: jump to the next block's front.
             nextSlab_ = std::max<int64_t>(nextSlab_, int64_t(std::floor(block(nextBlock_).dMin / slabLength_)));
@@ -927,7 +917,7 @@ bool VoxelStream::next(StreamWindow& window, const std::function<bool(int, int, 
         // The window: at least slabsPerWindow slabs, grown while it would hold too few voxels.
         int64_t slabEnd = nextSlab_ + slabsPerWindow_;
         size_t first = nextBlock_;
-        size_t estimate = unreleased_;
+        size_t estimate = pending_.size();
         while (nextBlock_ < order_.size() && block(nextBlock_).dMin < slabEnd * slabLength_) {
             estimate += recordsOf(block(nextBlock_));
             ++nextBlock_;
@@ -936,10 +926,9 @@ bool VoxelStream::next(StreamWindow& window, const std::function<bool(int, int, 
                 slabEnd = int64_t(std::floor(block(nextBlock_).dMin / slabLength_)) + slabsPerWindow_;
         }
         // Activate the blocks whose front the window reached: extract them in parallel, in order.
-        // The chunks' buffers are reused once their blocks are released (no allocation once warm).
+        // The chunks' buffers are reused window after window (no allocation once warm).
         const size_t count = nextBlock_ - first, chunks = (count + kExtractChunk - 1) / kExtractChunk;
-        claimChunks(chunks);
-        for (size_t c = 0; c < chunks; ++c) chunkUsers_[chunkSlot_[c]] = uint32_t(std::min(count, (c + 1) * kExtractChunk) - c * kExtractChunk);
+        if (extracted_.size() < chunks) extracted_.resize(chunks);
         skipped_.assign(count, 0);
         blockCounts_.assign(count, StreamCounts{});
         blockRecords_.resize(count);
@@ -948,7 +937,7 @@ bool VoxelStream::next(StreamWindow& window, const std::function<bool(int, int, 
         // on the thread count.
         tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t c = r.begin(); c < r.end(); ++c) {
-                VoxelBatch& e = extracted_[chunkSlot_[c]];
+                VoxelBatch& e = extracted_[c];
                 e.clear();
                 const size_t chunkEnd = std::min(count, (c + 1) * kExtractChunk);
                 // Room for the chunk's records at once: grown block by block, the arrays were
@@ -995,8 +984,8 @@ bool VoxelStream::next(StreamWindow& window, const std::function<bool(int, int, 
             counts_.aggregates += blockCounts_[i - first].aggregates;
             counts_.aggregatedVoxels += blockCounts_[i - first].aggregatedVoxels;
         }
-        // Release the voxels inside the window (the live blocks first, then the new blocks, in
-        // order); the blocks with voxels beyond it stay live.
+        // Release the voxels inside the window (pending first, then the new blocks in order);
+        // the rest stays pending, in the same order.
         release(count, float(slabEnd * slabLength_), window);
         window.slabBegin = nextSlab_;
         window.slabEnd = slabEnd;

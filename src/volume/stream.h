@@ -22,7 +22,6 @@
 #pragma once
 #include <array>
 #include <atomic>
-#include <cmath>
 #include <functional>
 #include <glm/glm.hpp>
 #include <memory>
@@ -66,43 +65,24 @@ struct VoxelBatch {
     void reserve(size_t n, bool depthSpreads);  ///< room for @p n records in every array (no pages touched)
 };
 
-/// @brief One block's records in a StreamWindow: records [begin, end) of a chunk, of which the
-/// window takes those whose distance is not under @p below (released by earlier windows; −∞:
-/// none was) and is under the window's limit, all of them when @p whole.
+/// @brief A run of a StreamWindow's records: records [begin, begin + count) of a buffer (a block's
+/// in its extraction chunk, or a stretch of the pending records), window records [first, first + count).
 struct WindowSource {
     const VoxelBatch* records = nullptr;
-    size_t begin = 0, end = 0;
-    float below = -INFINITY;
-    bool whole = false;  ///< every record of [begin, end) is the window's (no test needed)
-    size_t first = 0;    ///< the window's index of the first record it takes
-    size_t count = 0;    ///< how many it takes
-    /// @p f(i, n) for each run [i, i + n) of consecutive records it takes, in order.
-    template <class F>
-    void forEachRun(float limit, F&& f) const {
-        if (whole) {
-            if (end > begin) f(begin, end - begin);
-            return;
-        }
-        const float* d = records->distance.data();
-        for (size_t i = begin; i < end;) {
-            while (i < end && !(!(d[i] < below) && d[i] < limit)) ++i;
-            const size_t run = i;
-            while (i < end && !(d[i] < below) && d[i] < limit) ++i;
-            if (i > run) f(run, i - run);
-        }
-    }
+    size_t begin = 0;
+    size_t first = 0;  ///< the window's index of its first record
+    size_t count = 0;
 };
 
-/// @brief One depth window of voxels as views into the stream's extraction chunks (no copy,
-/// docs/performance.md, session 43): record k of the window is the (k − first)-th record that
-/// the source with first ≤ k < first + count takes. The same records, in the same order, as the
-/// VoxelBatch that VoxelStream::next(VoxelBatch&) copies out of it. Valid until the next next().
+/// @brief One depth window of voxels, read where they are (docs/performance.md, session 43): the
+/// runs of the stream's buffers it takes whole, in order, instead of a copy of them in one batch.
+/// The same records, in the same order, as the VoxelBatch that VoxelStream::next(VoxelBatch&)
+/// copies out of it. Valid until the next next().
 struct StreamWindow {
     std::vector<WindowSource> sources;
-    float limit = INFINITY;  ///< the window's far edge: it takes records under it
     size_t size = 0;
     int64_t slabBegin = 0, slabEnd = 0;  ///< as VoxelBatch's
-    /// The window of all of @p batch (its slabs), in sources of at most @p piece records.
+    /// The window of all of @p batch (its slabs), in runs of at most @p piece records.
     static StreamWindow of(const VoxelBatch& batch, size_t piece = 1024);
     /// Copies the window's records into @p batch, in order (withDepthSpread as @p depthSpread).
     void copyTo(VoxelBatch& batch, bool depthSpread) const;
@@ -257,10 +237,7 @@ struct PackedCells {
 /// to the next (render/hybrid.h, ForwardBuffers): they grow, never shrink, and are emptied or
 /// rewritten before use, so a render never depends on what they held.
 struct StreamBuffers {
-    /// The extraction chunks (kExtractChunk activated blocks each, their records in block order).
-    /// A chunk stays until the last of its blocks' records is released, so a block that straddles
-    /// a window's far edge keeps its records where they were extracted instead of copying them to
-    /// a pending buffer window after window (docs/performance.md, session 43).
+    VoxelBatch pending, pendingNext;
     std::vector<VoxelBatch> extracted;
     LodMomentCache moments;  ///< only with StreamOptions::keepMoments
 };
@@ -340,10 +317,10 @@ private:
                    VoxelBatch& out, StreamCounts& counts) const;
     template <typename Keep, typename Fn> void forEachActive(const Block& b, Keep&& keep, Fn&& fn) const;
     void adaptWindow(size_t released);  // the next window's slab count from this one's size
-    /// The records of the live blocks and of the window's @p blocks new ones under @p limit → @p window,
-    /// in block order; the blocks with records left stay live.
+    /// The pending records and the window's @p blocks new ones under @p limit → @p window (read where
+    /// they are, moved to the front of their source where it is taken in part), the rest → pending,
+    /// in the same order.
     void release(size_t blocks, float limit, StreamWindow& window);
-    void claimChunks(size_t chunks);  // chunkSlot_ for the window's chunks: free slots of extracted_, lowest first
 
     const Volume& volume_;
     const Camera& camera_;
@@ -357,23 +334,15 @@ private:
     const Block& block(size_t k) const { return blocks_[order_[k]]; }  // the k-th in order_
     size_t nextBlock_ = 0;
     std::unique_ptr<StreamBuffers> own_;  // the buffers, unless the caller keeps them
-    /// An activated block with records not yet released: records [begin, end) of extracted_[chunk],
-    /// of which those not under the last window's limit (releasedBelow_) are still to come.
-    struct LiveBlock {
-        uint32_t chunk;
-        size_t begin, end;
-    };
-    std::vector<VoxelBatch>& extracted_;  // the chunk pool (StreamBuffers::extracted): kept, reused
-    std::vector<uint32_t> chunkUsers_;    // per slot of extracted_: live blocks (and this window's) in it
-    std::vector<uint32_t> chunkSlot_;     // per chunk of the window's new blocks: its slot in extracted_
-    std::vector<LiveBlock> live_;         // blocks with records left, in the order they were activated
-    size_t unreleased_ = 0;               // records of live_ not yet released
-    float releasedBelow_ = -INFINITY;     // the last window's limit: records under it are released
+    VoxelBatch& pending_;         // voxels of activated blocks not yet released
+    VoxelBatch& pendingNext_;     // the pending voxels a window keeps (swapped with pending_)
+    std::vector<VoxelBatch>& extracted_;  // per chunk of kExtractChunk activated blocks of the window (reused)
     std::vector<std::pair<size_t, size_t>> blockRecords_;  // per activated block: its records in its chunk's buffer
     std::vector<char> skipped_;          // per activated block: hidden behind opaque tiles
     std::vector<StreamCounts> blockCounts_;  // per activated block: its aggregates
     LodMomentCache* moments_ = nullptr;  // kept moments (StreamOptions::keepMoments), or null
     int64_t nextSlab_ = 0;
+    size_t records_ = 0;          // about how many records the blocks give (recordsOf), once known
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
     glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)
     // The voxel's shape in world units (volume/grid.h: any affine map): the largest semi-axis
