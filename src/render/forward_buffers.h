@@ -1,6 +1,6 @@
 // render/forward_buffers.h — memory the forward pipeline can keep from one render to the next.
 // Owns: ForwardBuffers, every large buffer of renderForward (render/hybrid.h): the projected
-// window, the stream's extracted voxels (a window reads them there), the compositor's frame, sort
+// window, the stream's extracted and pending voxels (a window reads them there), the compositor's frame, sort
 // and bins. A command that renders many images (bench, animate, study) keeps one and passes it
 // in RenderControl::buffers; a single render needs none.
 //
@@ -24,7 +24,7 @@ struct ForwardBuffers {
     /// written; freeing them inside the render took 2–10 ms of a one-shot render on this project's
     /// virtual machines, docs/performance.md, session 29).
     bool keepMoments = true;
-    StreamWindow voxels;            ///< one window's voxels (views into the stream's chunks)
+    StreamWindow voxels;            ///< one window's voxels (runs of the stream's buffers)
     ProjectedWindow window;         ///< one window's primitives
     StreamBuffers stream;           ///< VoxelStream's pending and extracted voxels
     CompositorBuffers compositor;   ///< TileCompositor's frame, sort and bins

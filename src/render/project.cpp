@@ -140,8 +140,9 @@ Primitive makeEllipsoidSplat(const glm::dvec3& c, float sigma, double lowPass, c
     return p;
 }
 
-/// Up to kSplatLanes consecutive voxels of a window, copied out of the stream's chunks where it
-/// extracted them (StreamWindow) into one thread's scratch, in the runs the window takes of each.
+/// Up to kSplatLanes consecutive voxels of a window gathered from the ends of its runs
+/// (StreamWindow: a run shorter than a lane group, or what a group leaves of one) into one
+/// thread's scratch.
 struct LaneVoxels {
     std::array<glm::vec3, kSplatLanes> viewPos, color;
     std::array<float, kSplatLanes> distance, sigma, spread, depthSpread;
@@ -149,8 +150,8 @@ struct LaneVoxels {
     bool withDepthSpread = false;
     size_t n = 0;
     /// Records [@p i, @p i + @p m) of @p batch appended (m ≤ kSplatLanes − n). Record by record:
-    /// the runs a window takes of a block that straddles its edge are a few records long, and a
-    /// library copy per array per run cost more than the records (docs/performance.md, session 43).
+    /// m is short, and a library copy per array cost more than the records (docs/performance.md,
+    /// session 43).
     void append(const VoxelBatch& batch, size_t i, size_t m) {
         const glm::vec3* p = batch.viewPos.data() + i;
         const glm::vec3* c = batch.color.data() + i;

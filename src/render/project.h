@@ -95,8 +95,9 @@ std::optional<PointLaneContext> pointLaneContext(const ProjectionContext& ctx);
 /// batch's first slab. @return what the primitives draw, by kind.
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window);
 
-/// @brief projectBatch for a window read where the stream extracted it (StreamWindow): primitive
-/// k from the window's voxel k. The same primitives as projectBatch of the window copied out.
+/// @brief projectBatch for a window read where the stream left its voxels (StreamWindow: runs of
+/// its chunks and pending records): primitive k from the window's voxel k, split among threads
+/// by primitives. The same primitives as projectBatch of the window copied out.
 ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionContext& ctx, ProjectedWindow& window);
 
 /// @brief --compositing slabs: the slab fractions of a primitive at view position @p c, distance
