@@ -269,27 +269,7 @@ TEST(ProjectVector, ProjectBatchIsTheSameWithAndWithoutLanes) {
         if (mode == RenderMode::Hybrid) {
             EXPECT_GT(a.splats, 1000);
         }
-        ASSERT_EQ(lanes.size, scalar.size);
-        for (size_t i = 0; i < lanes.size; ++i) {
-            ASSERT_EQ(lanes.order[i], scalar.order[i]) << i;
-            if (lanes.order[i] == ProjectedWindow::kNotDrawn) continue;
-            const PrimitiveRecord &p = lanes.records[i], &q = scalar.records[i];
-            ASSERT_EQ(p.kind, q.kind) << i;
-            ASSERT_EQ(p.centre, q.centre) << i;
-            ASSERT_EQ(p.shape, q.shape) << i;
-            ASSERT_EQ(p.scale, q.scale) << i;
-            ASSERT_EQ(p.color, q.color) << i;
-            ASSERT_EQ(p.sin2Alpha, q.sin2Alpha) << i;
-            ASSERT_EQ(p.slab, q.slab) << i;
-            ASSERT_TRUE(p.range.x0 == q.range.x0 && p.range.y0 == q.range.y0 && p.range.x1 == q.range.x1 &&
-                        p.range.y1 == q.range.y1) << i;
-            ASSERT_EQ(lanes.tiles[i], scalar.tiles[i]) << i;
-            ASSERT_EQ(lanes.depth[i], scalar.depth[i]) << i;
-            ASSERT_EQ(lanes.members[i], scalar.members[i]) << i;
-            if (p.hasExactMap) {
-                ASSERT_TRUE(lanes.extra[i].exactMap == scalar.extra[i].exactMap) << i;
-            }
-        }
+        ASSERT_NO_FATAL_FAILURE(test::expectSameWindow(lanes, scalar));
     }
 }
 

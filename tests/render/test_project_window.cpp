@@ -16,33 +16,6 @@
 namespace vdbsplat {
 namespace {
 
-void expectSameWindow(const ProjectedWindow& a, const ProjectedWindow& b) {
-    ASSERT_EQ(a.size, b.size);
-    ASSERT_EQ(a.slabBase, b.slabBase);
-    ASSERT_EQ(a.slabEnd, b.slabEnd);
-    for (size_t i = 0; i < a.size; ++i) {
-        ASSERT_EQ(a.order[i], b.order[i]) << i;
-        ASSERT_EQ(a.depth[i], b.depth[i]) << i;
-        ASSERT_EQ(a.members[i], b.members[i]) << i;
-        if (a.order[i] == ProjectedWindow::kNotDrawn) continue;
-        const PrimitiveRecord &p = a.records[i], &q = b.records[i];
-        ASSERT_EQ(p.kind, q.kind) << i;
-        ASSERT_EQ(p.centre, q.centre) << i;
-        ASSERT_EQ(p.shape, q.shape) << i;
-        ASSERT_EQ(p.scale, q.scale) << i;
-        ASSERT_EQ(p.sin2Alpha, q.sin2Alpha) << i;
-        ASSERT_EQ(p.color, q.color) << i;
-        ASSERT_EQ(p.slab, q.slab) << i;
-        ASSERT_TRUE(p.range.x0 == q.range.x0 && p.range.y0 == q.range.y0 && p.range.x1 == q.range.x1 &&
-                    p.range.y1 == q.range.y1) << i;
-        ASSERT_EQ(a.tiles[i], b.tiles[i]) << i;
-        ASSERT_EQ(p.hasExactMap, q.hasExactMap) << i;
-        if (p.hasExactMap) {
-            ASSERT_TRUE(a.extra[i].exactMap == b.extra[i].exactMap) << i;
-        }
-    }
-}
-
 struct Case {
     const char* name;
     double distance;  ///< of the framing distance: 1 framed (splats), 2.5 and 6 farther (points, aggregates)
@@ -97,7 +70,7 @@ TEST_P(ProjectWindow, EqualsTheWindowCopiedOutAndProjected) {
         EXPECT_EQ(a.drawnVoxels, b.drawnVoxels);
         EXPECT_EQ(a.lodAggregates, b.lodAggregates);
         aggregates += a.lodAggregates;
-        expectSameWindow(inPlace, fromCopy);
+        ASSERT_NO_FATAL_FAILURE(test::expectSameWindow(inPlace, fromCopy));
         records += window.size;
     }
     EXPECT_GT(windows, 3u);
