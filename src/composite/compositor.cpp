@@ -442,9 +442,9 @@ void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t i, TilePixels& 
                                    const SlabTargets* slabs) const {
     switch (p.kind) {
         case PrimitiveKind::Point: drawPoint(p, px, slab, slabs); break;
-        case PrimitiveKind::Splat: drawSplat(p, window_->extra[i].exactMap, px, slabs); break;  // the map unread
+        case PrimitiveKind::Splat: drawSplat(p, window_->exactMaps[0], px, slabs); break;  // the map unread
         case PrimitiveKind::SplatExactIndex:  // without its map: the half-ray fallback
-            p.hasExactMap ? drawSplat(p, window_->extra[i].exactMap, px, slabs) : drawExact(p, window_->extra[i], px, slabs);
+            p.hasExactMap ? drawSplat(p, window_->exactMaps[ProjectedWindow::mapIndex(i, p.exactMapSlot)], px, slabs) : drawExact(p, window_->extra[i], px, slabs);
             break;
         case PrimitiveKind::SplatExact:
         case PrimitiveKind::NearEye: drawExact(p, window_->extra[i], px, slabs); break;
@@ -467,7 +467,7 @@ inline void TileCompositor::prefetchAhead(std::span<const Entry> entries, size_t
         }
     }
     if (e + kMapAhead < entries.size() && window_->records[indexOf(entries[e + kMapAhead])].hasExactMap) {
-        const char* c = reinterpret_cast<const char*>(&window_->extra[indexOf(entries[e + kMapAhead])].exactMap);
+        const char* c = reinterpret_cast<const char*>(&window_->exactMap(indexOf(entries[e + kMapAhead])));
         __builtin_prefetch(c), __builtin_prefetch(c + sizeof(ExactIndexMap) - 1);
     }
 }

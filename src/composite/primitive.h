@@ -4,9 +4,10 @@
 // ellipse widened by the low-pass, (i, α) reindex + footprint table), or a
 // near-eye kernel drawn with the exact half-ray integral (ellipse.h fallback);
 // and ProjectedWindow, a window of them as the renderer passes it on: structure of arrays
-// (a 64-byte PrimitiveRecord the tiles draw, the order key's parts, the voxel count, and the
-// rare kinds' extra data), so that each pass reads only what it needs (~80 B per primitive
-// written by projection instead of the ~200-byte Primitive).
+// (a 64-byte PrimitiveRecord the tiles draw, the order key's parts, the voxel count, the
+// exact-index splats' maps and the rare kinds' extra data), so that each pass reads only what it
+// needs (~80 B per drawn primitive written by projection instead of the ~200-byte Primitive),
+// compacted block by block so that what draws nothing leaves nothing in memory.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -79,18 +80,25 @@ struct PrimitiveRecord {
     PixelRange range;
     uint32_t slab;         ///< relative to the window's first slab (ProjectedWindow::slabBase)
     PrimitiveKind kind;
-    bool hasExactMap;      ///< SplatExactIndex: its PrimitiveExtra holds its ExactIndexMap
+    bool hasExactMap;      ///< SplatExactIndex: the window's exactMaps holds its ExactIndexMap
+    /// Where: exactMaps[its block's first slot + this] (ProjectedWindow::exactMap; a block's maps
+    /// are compacted as its records are).
+    uint16_t exactMapSlot;
 };
 static_assert(sizeof(PrimitiveRecord) == 64, "one cache line per primitive");
 
-/// What only SplatExactIndex (the map), SplatExact and NearEye (recomputed per tile) read.
+/// What only the kernels recomputed per tile read: SplatExact, NearEye, and a SplatExactIndex
+/// without its map (hasExactMap false: the half-ray fallback). An exact-index splat with its map
+/// reads the map alone (ProjectedWindow::exactMaps, 24 bytes: two thirds of the framed checker
+/// box's splats are such, and this struct beside the map was 16 bytes more of fresh memory each).
 struct PrimitiveExtra {
-    ExactIndexMap exactMap;
     glm::vec3 viewPos{0.f};
     float sigma = 0.f;
 };
-inline bool needsExtra(PrimitiveKind kind) {
-    return kind == PrimitiveKind::SplatExactIndex || kind == PrimitiveKind::SplatExact || kind == PrimitiveKind::NearEye;
+/// Whether a primitive of @p kind reads its PrimitiveExtra (@p hasExactMap: the record's).
+inline bool needsExtra(PrimitiveKind kind, bool hasExactMap) {
+    return kind == PrimitiveKind::SplatExact || kind == PrimitiveKind::NearEye ||
+           (kind == PrimitiveKind::SplatExactIndex && !hasExactMap);
 }
 
 /// The tiles of a clamped, non-empty pixel range, 16 bits each (images ≤ 16384 px: ≤ 512 tiles a
@@ -100,9 +108,16 @@ inline uint64_t tileRect(const PixelRange& r) {
            uint64_t(r.y1 / kTileSize) << 48;
 }
 
-/// A window of primitives, structure of arrays, element i from voxel i of the batch. Reused
-/// window after window (the buffers grow only), in huge pages where a window fills them.
+/// A window of primitives, structure of arrays. Compacted by blocks: the window's voxels
+/// [b·kBlock, (b + 1)·kBlock) give block b's slots, its drawn primitives first, in voxel order,
+/// and the rest of the block's slots not drawn (only their `order` is set: kNotDrawn). So a
+/// primitive that draws nothing (culled, off screen, or behind finished pixels) leaves no record
+/// in memory, and the order of the drawn ones, which the compositor's sort breaks ties by, is the
+/// voxels' order. Reused window after window (the buffers grow only), in huge pages where a
+/// window fills them.
 struct ProjectedWindow {
+    /// Voxels per compaction block: the projection's unit of work, too (one thread a block).
+    static constexpr size_t kBlock = 1024;
     template <class T>
     using Buffer = std::vector<T, HugePageAllocator<T>>;
     /// `order` of a primitive that draws nothing (culled, or no pixel on screen).
@@ -123,18 +138,28 @@ struct ProjectedWindow {
     /// what the compositor's binning reads, 8 bytes instead of the record's line. Unset where
     /// order is kNotDrawn.
     Buffer<uint64_t> tiles;
-    Buffer<PrimitiveExtra> extra;      ///< written only where needsExtra(kind)
+    /// The exact-index splats' maps, block by block: a block's maps fill its slots from the front
+    /// (exactMap(i)), so a window with few of them touches few pages of it.
+    Buffer<ExactIndexMap> exactMaps;
+    Buffer<PrimitiveExtra> extra;      ///< written only where needsExtra(kind, hasExactMap)
     Buffer<SlabProfile> profile;       ///< written only when `profiles`
 
     /// Grows the buffers to @p n primitives (contents undefined until set()).
     void resize(size_t n) {
         growDiscarding(records, n), growDiscarding(order, n), growDiscarding(depth, n);
-        growDiscarding(members, n), growDiscarding(extra, n), growDiscarding(tiles, n);
+        growDiscarding(members, n), growDiscarding(exactMaps, n), growDiscarding(extra, n), growDiscarding(tiles, n);
         if (profiles) growDiscarding(profile, n);
         size = n;
     }
-    /// Stores @p p as primitive @p i (its slab relative to slabBase, clamped to [0, kMaxRelativeSlab]).
-    void set(size_t i, const Primitive& p) {
+    /// The ExactIndexMap of primitive @p i (its record's hasExactMap).
+    const ExactIndexMap& exactMap(size_t i) const { return exactMaps[mapIndex(i, records[i].exactMapSlot)]; }
+    /// Where in exactMaps slot @p mapSlot of primitive @p i's block lies.
+    static size_t mapIndex(size_t i, uint16_t mapSlot) { return i / kBlock * kBlock + mapSlot; }
+    /// Stores @p p as primitive @p i (its slab relative to slabBase, clamped to [0, kMaxRelativeSlab]),
+    /// its map (if it has one) in exactMaps[@p map], which must lie in i's block (the projection
+    /// passes its block's next free map slot; by default the map lies beside the record, at i).
+    void set(size_t i, const Primitive& p) { set(i, p, i); }
+    void set(size_t i, const Primitive& p, size_t map) {
         const bool point = p.kind == PrimitiveKind::Point;
         PrimitiveRecord& q = records[i];
         q.centre = p.centre;
@@ -146,7 +171,9 @@ struct ProjectedWindow {
         q.kind = p.kind;
         q.hasExactMap = p.hasExactMap;
         place(i, p.slab, p.depth, p.members, p.kind, p.range);
-        if (needsExtra(p.kind)) extra[i] = PrimitiveExtra{p.exactMap, p.viewPos, p.sigma};
+        q.exactMapSlot = uint16_t(map % kBlock);
+        if (p.hasExactMap) exactMaps[map] = p.exactMap;
+        if (needsExtra(p.kind, p.hasExactMap)) extra[i] = PrimitiveExtra{p.viewPos, p.sigma};
         if (profiles) profile[i] = p.profile;
     }
     /// The rest of primitive @p i once records[i] holds all but its slab (set() does this; the

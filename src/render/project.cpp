@@ -187,8 +187,9 @@ struct LaneView {
 
 /// makeSplat's splat from lane @p k of a projectSplatsVector call, stored straight into
 /// @p window as primitive @p i (the fields set() would write from that Primitive; no Primitive
-/// is built). Returns its kind (Culled when it has no pixel on the image) and sets @p range.
-PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const LaneView& batch, int64_t slab,
+/// is built), an exact-index splat's map in exactMaps[@p map] (i's block's next free map slot).
+/// Returns its kind (Culled when it has no pixel on the image) and sets @p range.
+PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, size_t map, const LaneView& batch, int64_t slab,
                              const ProjectionContext& ctx, ProjectedWindow& window, PixelRange& range) {
     const uint8_t status = lanes.status[k];
     PrimitiveRecord& q = window.records[i];
@@ -204,10 +205,9 @@ PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, const 
     q.color = ctx.showPrimitives ? splatTint(batch.color[k]) : batch.color[k];
     q.range = range = lanes.range(k);
     window.place(i, slab, batch.distance[k], batch.members[k], kind, range);
-    if (kind == PrimitiveKind::SplatExactIndex) {  // in place (SplatLanes::exactMapInto)
-        PrimitiveExtra& extra = window.extra[i];
-        lanes.exactMapInto(k, extra.exactMap);
-        extra.viewPos = batch.viewPos[k], extra.sigma = batch.sigma[k];
+    if (kind == PrimitiveKind::SplatExactIndex) {  // it has its map: in place (SplatLanes::exactMapInto), in slot map
+        q.exactMapSlot = uint16_t(map % ProjectedWindow::kBlock);
+        lanes.exactMapInto(k, window.exactMaps[map]);
     }
     return kind;
 }
@@ -372,17 +372,19 @@ ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionConte
     const std::optional<SplatLaneContext> laneContext = splatLaneContext(ctx);
     // Points in lanes too (hybrid and point mode): the far views' and the clouds' voxels.
     const std::optional<PointLaneContext> pointContext = pointLaneContext(ctx);
+    const size_t blocks = (voxels.size + ProjectedWindow::kBlock - 1) / ProjectedWindow::kBlock;
     return tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, voxels.size, 1024), ProjectionCounts{},
+        tbb::blocked_range<size_t>(0, blocks, 1), ProjectionCounts{},
         [&](const tbb::blocked_range<size_t>& r, ProjectionCounts c) {
             SplatLanes lanes;
             PointLanes points;
             std::array<int64_t, kSplatLanes> slabs;  // of the group's voxels
             PendingProfiles profiles;                // --compositing slabs: the group's, in vectors
             LaneVoxels group;
-            // Primitives [r.begin(), r.end()) of the window, from the run that holds the first on
-            // (split by records, as a batch was: the runs' sizes vary, 1 to 4 096).
-            size_t next = r.begin();
+            // The window's blocks [r.begin(), r.end()) (ProjectedWindow::kBlock voxels each), each
+            // from the run that holds its first voxel on (the runs' sizes vary, 1 to 4 096). A
+            // block's drawn primitives fill its slots from the front, in voxel order (compacted).
+            size_t slot = 0, map = 0;  // the block's next free slot, and its next free exact-map slot
             // The group's voxels projected at once (their slabs, splats and points), then each stored
             // as the window's next primitive.
             const auto project = [&](const LaneView& batch) {
@@ -391,12 +393,12 @@ ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionConte
                 slabsOf(batch.distance, batch.n, ctx.slabLength, voxels.slabBegin, voxels.slabEnd - 1, slabs.data());
                 projectChunkInLanes(batch, laneContext, pointContext, lanes, points);
                 for (size_t k = 0; k < batch.n; ++k) {
-                    const size_t i = next++;
+                    const size_t i = slot;  // taken below only if it is drawn (its order is set)
                     const int64_t slab = slabs[k];  // clamp(⌊distance / slabLength⌋, the window's slabs)
                     PrimitiveKind kind;
                     PixelRange range;
                     if (laneContext && lanes.status[k] != SplatLanes::kScalar) {
-                        kind = storeLaneSplat(lanes, k, i, batch, slab, ctx, window, range);
+                        kind = storeLaneSplat(lanes, k, i, map, batch, slab, ctx, window, range);
                     } else if (pointContext && points.status[k] == PointLanes::kPoint) {
                         storeLanePoint(points, k, i, batch, slab, ctx, window, range);
                         kind = PrimitiveKind::Point;
@@ -405,7 +407,7 @@ ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionConte
                         p.members = batch.members[k];
                         p.depth = batch.distance[k];
                         p.slab = slab;
-                        window.set(i, p);  // its profile below (set() writes p's default one first)
+                        window.set(i, p, map);  // its profile below (set() writes p's default one first)
                         kind = p.kind, range = p.range;
                     }
                     if (kind == PrimitiveKind::Culled) continue;
@@ -421,6 +423,9 @@ ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionConte
                         c.hidden.voxels += members;
                         continue;
                     }
+                    if (window.order[i] == ProjectedWindow::kNotDrawn) continue;  // no pixel: the slot is reused
+                    ++slot;
+                    map += window.records[i].hasExactMap;
                     if (ctx.slabs.on) {
                         const glm::dvec3 v(batch.viewPos[k]);
                         const float depthSpread = batch.depthSpread ? batch.depthSpread[k] : 0.f;
@@ -436,24 +441,29 @@ ProjectionCounts projectWindow(const StreamWindow& voxels, const ProjectionConte
                 group.n = 0;
             };
             const auto after = [](size_t k, const WindowSource& run) { return k < run.first + run.count; };
-            for (auto run = std::upper_bound(voxels.sources.begin(), voxels.sources.end(), r.begin(), after);
-                 run != voxels.sources.end() && run->first < r.end(); ++run) {
-                const WindowSource& src = *run;
-                group.withDepthSpread = !src.records->depthSpread.empty();
-                const size_t from = std::max(r.begin(), src.first), to = std::min(r.end(), src.first + src.count);
-                for (size_t i = src.begin + (from - src.first), end = src.begin + (to - src.first); i < end;) {
-                    if (group.n == 0 && end - i >= kSplatLanes) {  // a whole lane group where it lies
-                        project(LaneView::in(*src.records, i, kSplatLanes));
-                        i += kSplatLanes;
-                        continue;
+            for (size_t block = r.begin(); block < r.end(); ++block) {
+                const size_t first = block * ProjectedWindow::kBlock, last = std::min(voxels.size, first + ProjectedWindow::kBlock);
+                slot = map = first;
+                for (auto run = std::upper_bound(voxels.sources.begin(), voxels.sources.end(), first, after);
+                     run != voxels.sources.end() && run->first < last; ++run) {
+                    const WindowSource& src = *run;
+                    group.withDepthSpread = !src.records->depthSpread.empty();
+                    const size_t from = std::max(first, src.first), to = std::min(last, src.first + src.count);
+                    for (size_t i = src.begin + (from - src.first), end = src.begin + (to - src.first); i < end;) {
+                        if (group.n == 0 && end - i >= kSplatLanes) {  // a whole lane group where it lies
+                            project(LaneView::in(*src.records, i, kSplatLanes));
+                            i += kSplatLanes;
+                            continue;
+                        }
+                        const size_t take = std::min(end - i, kSplatLanes - group.n);
+                        group.append(*src.records, i, take);
+                        i += take;
+                        if (group.n == kSplatLanes) flushGroup();
                     }
-                    const size_t take = std::min(end - i, kSplatLanes - group.n);
-                    group.append(*src.records, i, take);
-                    i += take;
-                    if (group.n == kSplatLanes) flushGroup();
                 }
+                flushGroup();
+                std::fill(window.order.begin() + ptrdiff_t(slot), window.order.begin() + ptrdiff_t(last), ProjectedWindow::kNotDrawn);
             }
-            flushGroup();
             profiles.flush(ctx.marginal, ctx.slabs.reach, window);
             return c;
         },

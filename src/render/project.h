@@ -90,9 +90,11 @@ std::optional<SplatLaneContext> splatLaneContext(const ProjectionContext& ctx);
 std::optional<PointLaneContext> pointLaneContext(const ProjectionContext& ctx);
 
 /// @brief Projects every voxel of @p batch into @p window (grown when needed, never shrunk: it
-/// is reused window after window): primitive i from voxel i (projectVoxel), with the voxel's
-/// depth, its slab clamped to the batch's, and its member count; window.slabBase is the
-/// batch's first slab. @return what the primitives draw, by kind.
+/// is reused window after window): each voxel through projectVoxel, with the voxel's depth, its
+/// slab clamped to the batch's, and its member count; window.slabBase is the batch's first slab.
+/// The window is compacted by blocks (ProjectedWindow::kBlock): the drawn primitives of voxels
+/// [b·kBlock, (b + 1)·kBlock) fill those slots from the front in voxel order, the rest are not
+/// drawn. @return what the primitives draw, by kind.
 ProjectionCounts projectBatch(const VoxelBatch& batch, const ProjectionContext& ctx, ProjectedWindow& window);
 
 /// @brief projectBatch for a window read where the stream left its voxels (StreamWindow: runs of

@@ -518,7 +518,9 @@ TEST(TileCompositor, HiddenIsExactPerPixel) {
 }
 
 // projectBatch is projectVoxel over the batch, in order, with the window's slab and depth, packed
-// into the window's arrays (record, order key, depth, members, extra), and counted by kind.
+// into the window's arrays (record, order key, depth, members, exact map, extra), and counted by
+// kind; compacted by blocks of ProjectedWindow::kBlock voxels: a block's drawn primitives fill its
+// slots from the front in voxel order, and its other slots are not drawn.
 TEST(ProjectBatch, EqualsProjectVoxelOneByOne) {
     const Camera camera = testCamera(64);
     // h = 0.1: projected spacing 3 px at z = 4, 0.27 px at z = 44: points and splats.
@@ -543,11 +545,17 @@ TEST(ProjectBatch, EqualsProjectVoxelOneByOne) {
     ASSERT_EQ(window.slabBase, 3);
     int kinds[6] = {};
     uint64_t drawnVoxels = 0;
+    size_t slot = 0, drawnSlots = 0;
     for (size_t i = 0; i < batch.size(); ++i) {
+        if (i % ProjectedWindow::kBlock == 0) slot = i;  // a block's slots start at its first voxel
         const Primitive q = projectVoxel(glm::dvec3(batch.viewPos[i]), batch.sigma[i], batch.color[i], ctx, batch.spread[i]);
-        const PrimitiveRecord& p = window.records[i];
-        ++kinds[int(p.kind)];
+        ++kinds[int(q.kind)];
         drawnVoxels += q.kind != PrimitiveKind::Culled ? batch.members[i] : 0;
+        const bool drawn = q.kind != PrimitiveKind::Culled && !q.range.empty();
+        if (!drawn) continue;  // no slot
+        const size_t j = slot++;
+        ++drawnSlots;
+        const PrimitiveRecord& p = window.records[j];
         const bool point = q.kind == PrimitiveKind::Point;
         ASSERT_EQ(p.kind, q.kind) << i;
         ASSERT_EQ(p.centre, q.centre) << i;
@@ -558,19 +566,23 @@ TEST(ProjectBatch, EqualsProjectVoxelOneByOne) {
         ASSERT_EQ(p.hasExactMap, q.hasExactMap) << i;
         ASSERT_TRUE(p.range.x0 == q.range.x0 && p.range.y0 == q.range.y0 && p.range.x1 == q.range.x1 &&
                     p.range.y1 == q.range.y1) << i;
-        if (q.hasExactMap && needsExtra(q.kind)) {
-            ASSERT_TRUE(window.extra[i].exactMap == q.exactMap) << i;
+        if (q.hasExactMap) {
+            ASSERT_TRUE(window.exactMap(j) == q.exactMap) << i;
         }
-        if (needsExtra(q.kind)) {
-            ASSERT_EQ(window.extra[i].viewPos, q.viewPos) << i;
+        if (needsExtra(q.kind, q.hasExactMap)) {
+            ASSERT_EQ(window.extra[j].viewPos, q.viewPos) << i;
         }
-        ASSERT_EQ(window.members[i], batch.members[i]) << i;
-        ASSERT_EQ(window.depth[i], batch.distance[i]) << i;
+        ASSERT_EQ(window.members[j], batch.members[i]) << i;
+        ASSERT_EQ(window.depth[j], batch.distance[i]) << i;
         const int64_t slab = std::clamp<int64_t>(int64_t(std::floor(batch.distance[i] / ctx.slabLength)), 3, 199);
         ASSERT_EQ(p.slab, uint32_t(slab - 3)) << i;
-        const bool drawn = q.kind != PrimitiveKind::Culled && !q.range.empty();
-        ASSERT_EQ(window.order[i], drawn ? uint32_t(slab - 3) * 2 + (point ? 0 : 1) : ProjectedWindow::kNotDrawn) << i;
+        ASSERT_EQ(window.order[j], uint32_t(slab - 3) * 2 + (point ? 0 : 1)) << i;
     }
+    // Every slot past its block's drawn ones is not drawn.
+    size_t notDrawn = 0;
+    for (size_t j = 0; j < batch.size(); ++j) notDrawn += window.order[j] == ProjectedWindow::kNotDrawn;
+    ASSERT_EQ(notDrawn, batch.size() - drawnSlots);
+    EXPECT_GT(notDrawn, 0u);  // the case the compaction is for is exercised
     EXPECT_EQ(counts.points, uint64_t(kinds[int(PrimitiveKind::Point)]));
     EXPECT_EQ(counts.drawnVoxels, drawnVoxels);
     EXPECT_GT(kinds[int(PrimitiveKind::Point)], 100);
