@@ -442,9 +442,9 @@ void TileCompositor::drawPrimitive(const TileRecord& p, uint32_t i, TilePixels& 
                                    const SlabTargets* slabs) const {
     switch (p.kind) {
         case PrimitiveKind::Point: drawPoint(p, px, slab, slabs); break;
-        case PrimitiveKind::Splat: drawSplat(p, window_->exactMaps[0], px, slabs); break;  // the map unread
+        case PrimitiveKind::Splat: drawSplat(p, window_->exactMaps[0], px, slabs); break;  // any map: a Splat reads none
         case PrimitiveKind::SplatExactIndex:  // without its map: the half-ray fallback
-            p.hasExactMap ? drawSplat(p, window_->exactMaps[ProjectedWindow::mapIndex(i, p.exactMapSlot)], px, slabs) : drawExact(p, window_->extra[i], px, slabs);
+            p.hasExactMap ? drawSplat(p, window_->exactMap(i, p), px, slabs) : drawExact(p, window_->extra[i], px, slabs);
             break;
         case PrimitiveKind::SplatExact:
         case PrimitiveKind::NearEye: drawExact(p, window_->extra[i], px, slabs); break;

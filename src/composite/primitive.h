@@ -151,10 +151,15 @@ struct ProjectedWindow {
         if (profiles) growDiscarding(profile, n);
         size = n;
     }
-    /// The ExactIndexMap of primitive @p i (its record's hasExactMap).
-    const ExactIndexMap& exactMap(size_t i) const { return exactMaps[mapIndex(i, records[i].exactMapSlot)]; }
-    /// Where in exactMaps slot @p mapSlot of primitive @p i's block lies.
-    static size_t mapIndex(size_t i, uint16_t mapSlot) { return i / kBlock * kBlock + mapSlot; }
+    /// The ExactIndexMap of primitive @p i, whose record @p r is (r.hasExactMap).
+    const ExactIndexMap& exactMap(size_t i, const PrimitiveRecord& r) const { return exactMaps[i / kBlock * kBlock + r.exactMapSlot]; }
+    const ExactIndexMap& exactMap(size_t i) const { return exactMap(i, records[i]); }
+    /// Where primitive @p i's map goes: exactMaps[@p map], which must lie in i's block; its record
+    /// is told (exactMapSlot). The caller writes the map there.
+    ExactIndexMap& mapSlotFor(size_t i, size_t map) {
+        records[i].exactMapSlot = uint16_t(map % kBlock);
+        return exactMaps[map];
+    }
     /// Stores @p p as primitive @p i (its slab relative to slabBase, clamped to [0, kMaxRelativeSlab]),
     /// its map (if it has one) in exactMaps[@p map], which must lie in i's block (the projection
     /// passes its block's next free map slot; by default the map lies beside the record, at i).
@@ -171,8 +176,7 @@ struct ProjectedWindow {
         q.kind = p.kind;
         q.hasExactMap = p.hasExactMap;
         place(i, p.slab, p.depth, p.members, p.kind, p.range);
-        q.exactMapSlot = uint16_t(map % kBlock);
-        if (p.hasExactMap) exactMaps[map] = p.exactMap;
+        if (p.hasExactMap) mapSlotFor(i, map) = p.exactMap;
         if (needsExtra(p.kind, p.hasExactMap)) extra[i] = PrimitiveExtra{p.viewPos, p.sigma};
         if (profiles) profile[i] = p.profile;
     }

@@ -205,10 +205,7 @@ PrimitiveKind storeLaneSplat(const SplatLanes& lanes, size_t k, size_t i, size_t
     q.color = ctx.showPrimitives ? splatTint(batch.color[k]) : batch.color[k];
     q.range = range = lanes.range(k);
     window.place(i, slab, batch.distance[k], batch.members[k], kind, range);
-    if (kind == PrimitiveKind::SplatExactIndex) {  // it has its map: in place (SplatLanes::exactMapInto), in slot map
-        q.exactMapSlot = uint16_t(map % ProjectedWindow::kBlock);
-        lanes.exactMapInto(k, window.exactMaps[map]);
-    }
+    if (kind == PrimitiveKind::SplatExactIndex) lanes.exactMapInto(k, window.mapSlotFor(i, map));  // it has its map: in place
     return kind;
 }
 
