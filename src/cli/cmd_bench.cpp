@@ -161,7 +161,7 @@ void declareBench(CLI::App& app) {
         "\n"
         "Renders FILE at the standard views (--distance 8 far, 1 framed, 0.35 close) in hybrid,\n"
         "splat-only and point-only mode, several runs each, and prints, per view and mode, the\n"
-        "median and minimum seconds of render() (as `vdbsplat render -v` reports it), the share of\n"
+        "median and minimum seconds of a render (as `vdbsplat render -v` reports it), the share of\n"
         "splats among drawn primitives, and the ratio of the mode's median to hybrid's at that view;\n"
         "then the median of those ratios over the views. Runs are interleaved (for each run: for\n"
         "each view: for each mode) so machine drift affects every mode alike. A benchmark, not a test.");
@@ -215,7 +215,7 @@ int runBench(const Args& args) {
             for (size_t mi = 0; mi < o.modes.size(); ++mi) {
                 Cell& cell = cells[di * o.modes.size() + mi];
                 RenderStats stats;
-                (void)render(volume, tf, o.settingsFor(cell.distance, cell.mode), stats, control);
+                (void)renderWindowed(volume, tf, o.settingsFor(cell.distance, cell.mode), stats, control);
                 if (o.verbose)
                     std::fprintf(stderr, "%s %d/%d  distance %-6s %-9s %.4f s\n", timed ? "run   " : "warmup",
                                  timed ? r - o.warmup + 1 : r + 1, timed ? o.runs : o.warmup,

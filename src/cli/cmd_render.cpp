@@ -112,7 +112,7 @@ int runRender(const Args& args) {
         meter = std::make_unique<ProgressMeter>(toString(settings.mode));
         control.progress = [&meter](double f) { meter->update(f); };
     }
-    Image image;
+    WindowedImage image;  // the forward modes' data window (render/render.h): a PNG is written from it
     // Kept between the warm-up renders and the timed one, and in every case freed only after the
     // image is written: a render that frees its own buffers pays for the unmapping inside its
     // time (2–10 ms of a one-shot render here; docs/performance.md, session 29). A single render
@@ -125,9 +125,9 @@ int runRender(const Args& args) {
         quiet.progress = nullptr;
         for (int i = 0; i < warmup; ++i) {
             RenderStats untimed;
-            (void)render(volume, tf, settings, untimed, quiet);
+            (void)renderWindowed(volume, tf, settings, untimed, quiet);
         }
-        image = render(volume, tf, settings, stats, control);
+        image = renderWindowed(volume, tf, settings, stats, control);
     } catch (const RenderStopped&) {
         throw Error("render interrupted by " + guard.signalName() + "; " + output + " not written");
     }

@@ -96,15 +96,19 @@ struct PngImage {
     std::string message() const { return image.message[0] ? std::string(image.message) : "unknown libpng error"; }
 };
 
-void writePng(const std::string& tmp, const std::string& path, const Image& image) {
-    if (image.width < 1 || image.height < 1) throw Error(path + ": write failed: empty image");
-    const std::vector<uint8_t> bytes = encodePng(image);  // image/png_writer.h
+/// Writes @p bytes to @p tmp (errors name the user's @p path).
+void writeFileBytes(const std::string& tmp, const std::string& path, const std::vector<uint8_t>& bytes) {
     std::FILE* file = std::fopen(tmp.c_str(), "wb");
     if (!file) throw Error(path + ": write failed: " + std::strerror(errno));
     const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size() && std::fflush(file) == 0;
     const int err = errno;
     if (std::fclose(file) != 0 && written) throw Error(path + ": write failed: " + std::strerror(errno));
     if (!written) throw Error(path + ": write failed: " + std::strerror(err));
+}
+
+void writePng(const std::string& tmp, const std::string& path, const Image& image) {
+    if (image.width < 1 || image.height < 1) throw Error(path + ": write failed: empty image");
+    writeFileBytes(tmp, path, encodePng(image));  // image/png_writer.h
 }
 
 /// Sets OpenEXR's own header limits (it checks them while reading a header, before it
@@ -247,6 +251,41 @@ void checkImagePath(const std::string& path) {
     std::error_code ec;
     if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) throw Error(path + ": folder does not exist");
     checkRegularOutputPath(path);
+}
+
+WindowedImage::WindowedImage(Image window, int x0_, int y0_, int width_, int height_)
+    : width(width_), height(height_), x0(x0_), y0(y0_), data(std::move(window)) {
+    if (width < 0 || height < 0 || x0 < 0 || y0 < 0 || int64_t(x0) + data.width > width || int64_t(y0) + data.height > height)
+        throw Error("image: a " + sizeText(data.width, data.height) + " window at (" + std::to_string(x0) + ", " +
+                    std::to_string(y0) + ") does not lie inside a " + sizeText(width, height) + " image");
+}
+
+Image WindowedImage::full() const& {
+    Image out(width, height);
+    adviseRowsWritten(out, y0, data.height, data.width);
+    for (int v = 0; v < data.height; ++v)
+        std::copy_n(&data.pixels[size_t(v) * size_t(data.width)], size_t(data.width), &out.at(x0, y0 + v));
+    return out;
+}
+
+Image WindowedImage::full() && {
+    if (x0 == 0 && y0 == 0 && data.width == width && data.height == height) return std::move(data);
+    return static_cast<const WindowedImage&>(*this).full();
+}
+
+void writeImage(const std::string& path, const WindowedImage& image, const std::map<std::string, std::string>& metadata) {
+    checkImagePath(path);
+    if (extensionOf(path) != ".png") return writeImage(path, image.full(), metadata);
+    const std::string target = resolveOutputPath(path);
+    const std::string tmp = temporaryPathFor(target, ".png");  // same folder: the rename is atomic
+    try {
+        if (image.width < 1 || image.height < 1) throw Error(path + ": write failed: empty image");
+        writeFileBytes(tmp, path, encodePng(image));
+        renameIntoPlace(tmp, target, path);
+    } catch (...) {
+        std::remove(tmp.c_str());
+        throw;
+    }
 }
 
 void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata) {

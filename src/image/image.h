@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "util/error.h"
 #include "util/huge_pages.h"
 
 namespace vdbsplat {
@@ -67,6 +68,35 @@ struct Image {
     const glm::vec4& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
 };
 
+/// @brief An image transparent (all zero) outside one rectangle, its data window (OpenEXR's term),
+/// and stored as that rectangle alone: what a render cropped to the pixels its volume covers
+/// gives (render/hybrid.cpp), and what `render` writes. A far view's 1024² image holds a 110²
+/// rectangle; placed into a full Image, each of its rows wrote into a fresh page of its own (200
+/// page faults, 1.5–1.9 ms of a 7.7 ms warm far render on this project's hosts; docs/performance.md,
+/// session 46). The PNG writer reads the rectangle and writes the rest as zeros without a full
+/// image (writeImage below); full() places it where an Image is needed.
+struct WindowedImage {
+    int width = 0, height = 0;  ///< the whole image
+    int x0 = 0, y0 = 0;         ///< the data window's first column and row; its size is data's
+    Image data;                 ///< the data window's pixels (empty: all transparent)
+
+    WindowedImage() = default;
+    /// All of @p image (the data window is the whole image).
+    explicit WindowedImage(Image image) : width(image.width), height(image.height), data(std::move(image)) {}
+    /// @p window placed at (@p x0, @p y0) of a @p width × @p height image; it must lie inside it.
+    /// @throw Error when it does not.
+    WindowedImage(Image window, int x0, int y0, int width, int height);
+
+    /// Pixel (@p x, @p y) of the whole image: the data window's, or zero outside it.
+    glm::vec4 at(int x, int y) const {
+        const int u = x - x0, v = y - y0;
+        return u >= 0 && v >= 0 && u < data.width && v < data.height ? data.at(u, v) : glm::vec4(0.f);
+    }
+    /// The whole image: the data window placed, zero elsewhere (the data moved where it is the whole).
+    Image full() const&;
+    Image full() &&;
+};
+
 /// @brief Advises huge pages (huge_pages::adviseWritten) for the rows [@p y0, @p y0 + @p rows) of
 /// @p image, which the caller is about to write @p columns of each, if that is at least half of
 /// each row: a far view's crop writes a few hundred pixels of a 1024-pixel row, and a huge page of
@@ -109,6 +139,11 @@ uint8_t linearToSrgbCode(float v);
 /// EXR files carry @p metadata as string attributes.
 /// @throw Error naming the path on an unknown extension or a write failure.
 void writeImage(const std::string& path, const Image& image,
+                const std::map<std::string, std::string>& metadata = {});
+/// @brief As above, for an image stored as its data window: a PNG is encoded from the window and
+/// zeros, the same bytes as writeImage(path, image.full()) (no full image is built); an EXR is
+/// written from image.full().
+void writeImage(const std::string& path, const WindowedImage& image,
                 const std::map<std::string, std::string>& metadata = {});
 
 /// @brief Reads a PNG (sRGB, decoded to linear) or EXR (linear) back into an Image.

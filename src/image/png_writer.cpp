@@ -100,12 +100,29 @@ void putChunk(std::vector<uint8_t>& out, const char (&type)[5], const uint8_t* d
     closeChunk(out, start);
 }
 
-/// Row @p y of @p image as 8-bit sRGB codes over black (RGB).
-void encodeRow(const Image& image, int y, uint8_t* rgb) {
+/// What the encoder reads: @p data placed at (x0, y0) of a width × height image, zero elsewhere
+/// (an Image is its own whole window).
+struct PixelRows {
+    const Image& data;
+    int x0 = 0, y0 = 0, width = 0, height = 0;
+};
+
+/// Row @p y of @p image as 8-bit sRGB codes over black (RGB); a zero pixel's code is 0.
+void encodeRow(const PixelRows& image, int y, uint8_t* rgb) {
     const SrgbEncoder& encode = srgbEncoder();
-    const glm::vec4* px = &image.pixels[size_t(y) * size_t(image.width)];
-    for (int x = 0; x < image.width; ++x)
-        for (int c = 0; c < 3; ++c) rgb[3 * x + c] = encode(px[x][c]);
+    const Image& data = image.data;
+    const int v = y - image.y0;
+    uint8_t* const end = rgb + 3 * size_t(image.width);
+    if (v < 0 || v >= data.height || data.width == 0) {
+        std::fill(rgb, end, uint8_t(0));
+        return;
+    }
+    uint8_t* out = rgb + 3 * size_t(image.x0);
+    std::fill(rgb, out, uint8_t(0));
+    const glm::vec4* px = &data.pixels[size_t(v) * size_t(data.width)];
+    for (int x = 0; x < data.width; ++x)
+        for (int c = 0; c < 3; ++c) out[3 * x + c] = encode(px[x][c]);
+    std::fill(out + 3 * size_t(data.width), end, uint8_t(0));
 }
 
 /// The Paeth filter (PNG §9.4) of @p row (@p n bytes, 3 per pixel) against @p prior (the row
@@ -147,7 +164,7 @@ struct Band {
 
 /// Rows [@p y0, @p y1) of @p image, filtered and deflated; @p last ends the stream (else a sync
 /// flush ends the band on a byte boundary); @p first carries the zlib header before them.
-void encodeBand(const Image& image, int y0, int y1, bool first, bool last, Deflater& deflater, Band& band) {
+void encodeBand(const PixelRows& image, int y0, int y1, bool first, bool last, Deflater& deflater, Band& band) {
     const size_t rowBytes = size_t(image.width) * 3, lineBytes = rowBytes + 1;
     std::vector<uint8_t> rgb(2 * rowBytes, 0), filtered(size_t(y1 - y0) * lineBytes);
     uint8_t* prior = rgb.data();  // zeros above the first row
@@ -185,11 +202,8 @@ void encodeBand(const Image& image, int y0, int y1, bool first, bool last, Defla
     closeChunk(out, chunk);
 }
 
-}  // namespace
-
-uint8_t linearToSrgbCode(float v) { return srgbEncoder()(v); }
-
-std::vector<uint8_t> encodePng(const Image& image) {
+/// The PNG file of @p image (encodePng's two forms).
+std::vector<uint8_t> encodeRows(const PixelRows& image) {
     if (image.width < 1 || image.height < 1) throw std::invalid_argument("empty image");
     const int bands = (image.height + kPngBandRows - 1) / kPngBandRows;
     std::vector<Band> parts(static_cast<size_t>(bands));
@@ -221,6 +235,16 @@ std::vector<uint8_t> encodePng(const Image& image) {
     putChunk(file, "IDAT", trailer.data(), trailer.size());
     putChunk(file, "IEND", nullptr, 0);
     return file;
+}
+
+}  // namespace
+
+uint8_t linearToSrgbCode(float v) { return srgbEncoder()(v); }
+
+std::vector<uint8_t> encodePng(const Image& image) { return encodeRows({image, 0, 0, image.width, image.height}); }
+
+std::vector<uint8_t> encodePng(const WindowedImage& image) {
+    return encodeRows({image.data, image.x0, image.y0, image.width, image.height});
 }
 
 }  // namespace vdbsplat

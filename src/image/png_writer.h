@@ -18,6 +18,7 @@
 namespace vdbsplat {
 
 struct Image;
+struct WindowedImage;
 
 /// Rows per independently deflated band (the last may have fewer). Each band restarts the
 /// run-length coder and its Huffman tables: ~100 bytes per band against one stream.
@@ -27,5 +28,7 @@ inline constexpr int kPngBandRows = 32;
 /// premultiplied colour is the colour over black), the sRGB chunk, no alpha.
 /// @throw std::invalid_argument for an empty image; std::bad_alloc when zlib has no memory.
 std::vector<uint8_t> encodePng(const Image& image);
+/// @brief The same file as encodePng(image.full()), read from the data window and zeros.
+std::vector<uint8_t> encodePng(const WindowedImage& image);
 
 }  // namespace vdbsplat

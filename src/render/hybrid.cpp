@@ -46,11 +46,11 @@ struct ForwardPass {
 };
 
 /// What becomes of the composited frame: the output image made from it in place (copied, or
-/// postfiltered, into the final image's rectangle), while the compositor still holds it.
-using FrameSink = std::function<Image(const FrameView&)>;
+/// postfiltered, into the image's data window), while the compositor still holds it.
+using FrameSink = std::function<WindowedImage(const FrameView&)>;
 
 /// Streams, projects and composites @p volume onto @p camera's pixels; returns @p sink's image of the frame.
-Image composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, PendingTables& pending,
+WindowedImage composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, PendingTables& pending,
                 const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
                 const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission, const FrameSink& sink) {
     // The kernels' shape in view space (anisotropic or sheared voxels: ellipsoids).
@@ -198,25 +198,26 @@ double subpixelThreshold(double threshold, int k) {
 }
 
 /// A @p width × @p height image, transparent (T = 1, no radiance) except for @p frame at (@p x0, @p y0):
-/// the rows copied in parallel; the rest is the image's zero pages, never touched.
-Image placed(const FrameView& frame, int x0, int y0, int width, int height) {
-    Image out(width, height);
-    adviseRowsWritten(out, y0, frame.height, frame.width);
+/// its data window, the frame's rows copied in parallel.
+WindowedImage placed(const FrameView& frame, int x0, int y0, int width, int height) {
+    Image window(frame.width, frame.height);
+    adviseRowsWritten(window, 0, frame.height, frame.width);
     tbb::parallel_for(tbb::blocked_range<int>(0, frame.height, 16), [&](const tbb::blocked_range<int>& r) {
         for (int y = r.begin(); y < r.end(); ++y)
-            for (int x = 0; x < frame.width; ++x) out.at(x0 + x, y0 + y) = frame.at(x, y);
+            for (int x = 0; x < frame.width; ++x) window.at(x, y) = frame.at(x, y);
     });
-    return out;
+    return WindowedImage(std::move(window), x0, y0, width, height);
 }
 
 }  // namespace
 
-Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
+WindowedImage renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     PendingTables& tables, const RenderSettings& settings, RenderStats& stats,
                     const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
     // Fixed costs follow the pixels the volume covers, not the image: the compositor, its
     // tiles and the postfilter see only that rectangle (a cropped camera: the same rays, so the
-    // same image there, up to the float rounding of pixel coordinates); the rest is empty.
+    // same image there, up to the float rounding of pixel coordinates), and the image stores only
+    // it (its data window); the rest is empty.
     // Ewa and Swan fold V_h into each primitive by definition (the prefilter order); None has no
     // low-pass at all, and no level of detail (an aggregate is a prefiltered point).
     if (settings.filterOrder == FilterOrder::Prefilter || modeFixesFilterOrder(settings.mode)) {
@@ -245,12 +246,12 @@ Image renderForward(const Volume& volume, const ClassificationTable& table, cons
     // image is that output rectangle with its own border, as subpixelCamera frames the whole image.
     const std::optional<PixelRange> crop =
         coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, tables.kernel()), grid.border);
-    // The postfilter reads the compositor's frame and writes the output image's rectangle.
+    // The postfilter reads the compositor's frame and writes the output image's data window.
     const auto filtered = [&](int x0, int y0, int w, int h) {
         return [&camera, &grid, x0, y0, w, h](const FrameView& f) {
-            Image out(camera.width(), camera.height());
-            postfilterInto(f, grid, w, h, out, x0, y0);
-            return out;
+            Image window(w, h);
+            postfilterInto(f, grid, w, h, window, 0, 0);
+            return WindowedImage(std::move(window), x0, y0, camera.width(), camera.height());
         };
     };
     if (!crop)

@@ -19,7 +19,9 @@ class PendingTables;  // render/pending_tables.h
 /// @brief Renders @p volume in settings.mode (Hybrid, Splat or Point).
 /// @p tables: for settings.kernel, waited for where the compositor first needs them.
 /// @p emission: each voxel's emission (nullptr: none; docs/emission.md).
-Image renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
+/// @return the image as its data window: the pixels the volume's primitives can reach (all of
+/// the image where no crop applies); transparent elsewhere.
+WindowedImage renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
                     PendingTables& tables, const RenderSettings& settings, RenderStats& stats,
                     const VoxelShader* shader = nullptr, const RenderControl& control = {},
                     const EmissionSource* emission = nullptr);

@@ -99,8 +99,8 @@ uint64_t minorPageFaults() {
 }
 }  // namespace
 
-Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& requested, RenderStats& stats,
-             const RenderControl& control) {
+WindowedImage renderWindowed(const Volume& volume, const TransferFunction& tf, const RenderSettings& requested,
+                             RenderStats& stats, const RenderControl& control) {
     const auto start = std::chrono::steady_clock::now();
     const uint64_t faultsBefore = minorPageFaults();
     if (control.stop && control.stop()) throw RenderStopped("render stopped before it began");
@@ -127,7 +127,7 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     // Emission (docs/emission.md): the attached grid's ε, added to every voxel after shading.
     std::unique_ptr<EmissionSource> emission;
     if (settings.emission.active()) emission = makeEmissionSource(volume, settings.emission);
-    Image image;
+    WindowedImage image;
     switch (settings.mode) {
         case RenderMode::Reference: {
             std::unique_ptr<ShadingField> field;
@@ -135,8 +135,8 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
                 field = std::make_unique<ShadingField>(*shader);
                 stats.shadingSeconds = field->seconds();
             }
-            image = renderReference(volume, table, camera, settings.spp, stats, field.get(), control, emission.get(),
-                                    KernelShape::named(settings.kernel));
+            image = WindowedImage(renderReference(volume, table, camera, settings.spp, stats, field.get(), control,
+                                                  emission.get(), KernelShape::named(settings.kernel)));
             break;
         }
         case RenderMode::Hybrid:
@@ -153,6 +153,19 @@ Image render(const Volume& volume, const TransferFunction& tf, const RenderSetti
     const uint64_t faultsAfter = minorPageFaults();
     stats.pageFaults = faultsAfter > faultsBefore ? faultsAfter - faultsBefore : 0;
     if (control.progress) control.progress(1.0);
+    return image;
+}
+
+Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings, RenderStats& stats,
+             const RenderControl& control) {
+    const auto start = std::chrono::steady_clock::now();
+    const uint64_t faultsBefore = minorPageFaults();
+    Image image = renderWindowed(volume, tf, settings, stats, control).full();
+    // The whole image is this render's output: its time and page faults count (renderWindowed's
+    // include neither).
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const uint64_t faultsAfter = minorPageFaults();
+    stats.pageFaults = faultsAfter > faultsBefore ? faultsAfter - faultsBefore : 0;
     return image;
 }
 

@@ -40,7 +40,15 @@ RenderSettings resolvedFor(const Volume& volume, const Camera& camera, RenderSet
 /// @throw Error for settings the mode cannot honour.
 /// @param control optional progress report and stop request (Ctrl-C); see RenderControl.
 /// @throw RenderStopped when control.stop returned true.
+/// stats.seconds and stats.pageFaults cover the whole call, the full image's placement included.
 Image render(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings, RenderStats& stats,
              const RenderControl& control = {});
+
+/// @brief render() without placing the image: the forward modes' image as its data window (the
+/// pixels the volume can reach; render/hybrid.h), the reference's whole. stats.seconds and
+/// stats.pageFaults cover this call. What `render` and `bench` use: writing a PNG reads the window
+/// alone (writeImage), and a far view's full image is written a fresh page a row (session 46).
+WindowedImage renderWindowed(const Volume& volume, const TransferFunction& tf, const RenderSettings& settings,
+                             RenderStats& stats, const RenderControl& control = {});
 
 }  // namespace vdbsplat

@@ -201,6 +201,65 @@ TEST(Image, PngKeepsEveryCodeOfALargeImage) {
     EXPECT_EQ(wrong, 0);
 }
 
+// A render's image is stored as its data window (WindowedImage): full() must place the window
+// and leave the rest zero, and a window that does not lie inside its image is refused.
+TEST(Image, WindowedImagePlacesItsWindowAndZerosTheRest) {
+    const Image window = noiseImage(5, 3, 99, 0.5f);
+    const WindowedImage w(window, 2, 4, 9, 8);
+    const Image full = w.full();
+    ASSERT_EQ(full.width, 9);
+    ASSERT_EQ(full.height, 8);
+    int placed = 0;
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 9; ++x) {
+            const bool inside = x >= 2 && x < 7 && y >= 4 && y < 7;
+            const glm::vec4 expected = inside ? window.at(x - 2, y - 4) : glm::vec4(0.f);
+            EXPECT_EQ(full.at(x, y), expected) << x << "," << y;
+            EXPECT_EQ(w.at(x, y), expected) << x << "," << y;
+            placed += inside;
+        }
+    EXPECT_EQ(placed, 15);
+    // The whole window moves out as it is.
+    const Image moved = WindowedImage(window).full();
+    EXPECT_TRUE(std::equal(window.pixels.begin(), window.pixels.end(), moved.pixels.begin()));
+    EXPECT_NE(errorOf([&] { WindowedImage(window, 5, 4, 9, 8); }).find("does not lie inside a 9x8 image"), std::string::npos);
+    EXPECT_NE(errorOf([&] { WindowedImage(window, 2, 6, 9, 8); }).find("window at (2, 6)"), std::string::npos);
+    EXPECT_NE(errorOf([&] { WindowedImage(window, -1, 0, 9, 8); }).find("does not lie inside"), std::string::npos);
+}
+
+// The PNG of a data window is encoded from the window and zeros: the same file, byte for byte, as
+// the PNG of its full image, for windows at the corners, the edges, across band boundaries
+// (kPngBandRows), one pixel, empty, and the whole image; the EXR likewise reads back the full image.
+TEST(Image, WindowedPngIsTheFullImagesFileByteForByte) {
+    test::ScratchDir dir("image");
+    struct Case {
+        int w, h, x0, y0, width, height;
+    };
+    const Case cases[] = {{30, 20, 0, 0, 100, 70},  {30, 20, 70, 50, 100, 70}, {100, 3, 0, 31, 100, 70},
+                          {7, 70, 93, 0, 100, 70},  {1, 1, 50, 33, 100, 70},   {0, 0, 0, 0, 100, 70},
+                          {100, 70, 0, 0, 100, 70}, {45, 40, 17, 29, 62, 97}};
+    int i = 0;
+    for (const Case& c : cases) {
+        Image window = noiseImage(c.w, c.h, 31u + uint32_t(i), 0.75f);
+        if (c.w > 2) window.at(1, 0) = glm::vec4(0.f);  // a zero inside the window, too
+        const WindowedImage w(window, c.x0, c.y0, c.width, c.height);
+        const std::string tag = std::to_string(i++);
+        writeImage(dir.path("w" + tag + ".png"), w);
+        writeImage(dir.path("f" + tag + ".png"), w.full());
+        const std::string windowed = test::slurp(dir.path("w" + tag + ".png")), full = test::slurp(dir.path("f" + tag + ".png"));
+        ASSERT_GT(full.size(), 50u) << tag;
+        EXPECT_TRUE(windowed == full) << "case " << tag;
+        writeImage(dir.path("w" + tag + ".exr"), w);
+        const Image back = readImage(dir.path("w" + tag + ".exr")), expected = w.full();
+        ASSERT_EQ(back.pixels.size(), expected.pixels.size()) << tag;
+        EXPECT_TRUE(std::equal(back.pixels.begin(), back.pixels.end(), expected.pixels.begin())) << tag;
+    }
+    // An unknown extension is refused before anything is written, as for an Image.
+    EXPECT_NE(errorOf([&] { writeImage(dir.path("x.tif"), WindowedImage(noiseImage(2, 2, 1, 0.f), 0, 0, 4, 4)); }).find("x.tif"),
+              std::string::npos);
+    EXPECT_FALSE(fs::exists(dir.path("x.tif")));
+}
+
 // EXR line blocks are compressed on TBB's number of threads; the file must not depend on it.
 TEST(Image, ExrBytesDoNotDependOnTheThreadCount) {
     test::ScratchDir dir("image");

@@ -814,6 +814,42 @@ TEST(Forward, CroppingToTheVolumeKeepsTheImage) {
     }
 }
 
+// renderWindowed gives the forward modes' image as its data window: the pixels the volume can
+// reach. Its full image must be render()'s, bit for bit (cropped far and off to the side, whole
+// framed), and at the far view the window must be a small part of the image (else nothing is
+// saved: the far view's rows each wrote a fresh page of the whole image; session 46).
+TEST(Forward, RenderWindowedIsRendersImage) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    const Volume& v = marschnerLobb();
+    for (const RenderMode mode : {RenderMode::Hybrid, RenderMode::Splat, RenderMode::Ewa})
+        for (const FilterOrder order : {FilterOrder::Postfilter, FilterOrder::Prefilter})
+            for (const double distance : {4.0, 1.0}) {
+                if (modeFixesFilterOrder(mode) && order == FilterOrder::Prefilter) continue;
+                RenderSettings s = settingsFor(mode, distance);
+                s.filterOrder = order;
+                RenderStats st;
+                const WindowedImage w = renderWindowed(v, tf, s, st);
+                const Image a = w.full(), b = renderWith(v, tf, s);
+                ASSERT_EQ(a.pixels.size(), b.pixels.size());
+                EXPECT_TRUE(std::equal(a.pixels.begin(), a.pixels.end(), b.pixels.begin()))
+                    << toString(mode) << " " << toString(order) << " " << distance;
+                EXPECT_EQ(w.width, b.width);
+                EXPECT_EQ(w.height, b.height);
+                if (distance == 4.0) {
+                    EXPECT_LT(4 * int64_t(w.data.width) * w.data.height, int64_t(w.width) * w.height) << toString(mode);
+                    EXPECT_GT(w.x0, 0);
+                    EXPECT_GT(w.y0, 0);
+                }
+            }
+    // The reference is its whole image.
+    RenderSettings r = settingsFor(RenderMode::Reference, 4.0);
+    r.spp = 1;
+    RenderStats st;
+    const WindowedImage w = renderWindowed(v, tf, r, st);
+    EXPECT_EQ(w.data.width, w.width);
+    EXPECT_EQ(w.data.height, w.height);
+}
+
 // One colour channel (ColorChannels::Grey) is a speed knob, never an image knob: with a grey
 // transfer function the image is the three-channel one bit for bit, in every forward mode, far
 // (points and level-of-detail cells), framed and close, in the slab order and shaded, and the
