@@ -520,14 +520,14 @@ int runAnimate(const Args& args) {
             ++skipped;
         } else {
             RenderStats st;
-            const Image im = render(volume, tf, s, st, control);
+            const WindowedImage im = renderWindowed(volume, tf, s, st, control);  // timed as `vdbsplat render` times it
             writeImage(framePath.string(), im,
                        {{"settings", s.toJson().dump()},
                         {"camera", cameras[i].describe()},
                         {"mode", toString(s.mode)},
                         {"transfer_function", tf.toJson()},
                         {"seconds", std::to_string(st.seconds)}});
-            image = o.format == "png" ? readImage(framePath.string()) : im;  // metrics of the frame as written
+            image = o.format == "png" ? readImage(framePath.string()) : im.full();  // metrics of the frame as written
             FrameRecord r;
             r.frame = (long long)i;
             r.time = frames[i].time;

@@ -334,7 +334,7 @@ Rendered makeRender(const fs::path& stem, const std::string& hash, const nlohman
     const RenderSettings s = resolvedFor(volume, camera, requested);  // --subpixels auto: the k used
     RenderStats st;
     Rendered r;
-    r.image = render(volume, tf, s, st, control);
+    r.image = renderWindowed(volume, tf, s, st, control).full();  // timed as `vdbsplat render` times it
     r.seconds = st.seconds;
     r.points = st.points;
     r.splats = st.splats;

@@ -399,7 +399,7 @@ std::string reportHtml(const StudyResult& study) {
     s << "<p class=\"meta\">" << study.width << "×" << study.height << " pixels, reference " << study.spp
       << " rays per pixel, transfer function <code>" << htmlEscape(study.tf) << "</code>; modes " << htmlEscape(modes)
       << "; kernels " << htmlEscape(kernels) << ". Metrics on display values (sRGB over black) against the "
-      << "reference of the same kernel, camera and prefilter; times are one render() each on this machine. "
+      << "reference of the same kernel, camera and prefilter; times are one render each on this machine, as `vdbsplat render` times it. "
       << "Files: <a href=\"metrics.csv\">metrics.csv</a>, <a href=\"metrics.json\">metrics.json</a>, "
       << "<a href=\"command.txt\">command.txt</a>.</p>\n<p class=\"meta\">Made by <code>" << htmlEscape(study.command)
       << "</code></p>\n<nav><p>";
