@@ -58,6 +58,7 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
                          StreamBuffers* buffers)
     : volume_(volume), camera_(camera), table_(table), options_(options), shader_(shader), emission_(emission),
       slabLength_(options.slabThickness * volume.voxelSize), own_(buffers ? nullptr : std::make_unique<StreamBuffers>()),
+      blockList_(buffers ? buffers->blocks : own_->blocks), blocks_(blockList_.all), order_(blockList_.order),
       pending_(buffers ? buffers->pending : own_->pending), pendingNext_(buffers ? buffers->pendingNext : own_->pendingNext),
       extracted_(buffers ? buffers->extracted : own_->extracted), slabsPerWindow_(std::max(1, options.slabsPerWindow)) {
     pending_.clear();  // kept buffers: what a stopped render left
@@ -91,10 +92,12 @@ void VoxelStream::collectBlocks() {
     // The leaves from the internal nodes' tables (the leaf iterator's order), their voxel counts in
     // parallel: each count reads a leaf's mask for the first time since the load, and the iterator
     // walked them one dependent miss after another (0.5 ms of the far Engine's 10).
-    std::vector<const openvdb::FloatTree::LeafNodeType*> leaves;
+    std::vector<const openvdb::FloatTree::LeafNodeType*>& leaves = blockList_.leaves;
+    leaves.clear();
     leaves.reserve(tree.leafCount());
     tree.getNodes(leaves);
-    std::vector<uint32_t> onVoxels(leaves.size());
+    std::vector<uint32_t>& onVoxels = blockList_.onVoxels;
+    onVoxels.resize(leaves.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) onVoxels[i] = uint32_t(leaves[i]->onVoxelCount());
     });
@@ -120,7 +123,8 @@ void VoxelStream::collectBlocks() {
     // Distance bounds of voxel centres (the block's bounding sphere around its centre), the frustum
     // test and the level of detail, block by block in parallel (each writes only its own block).
     const double halfDiagonal = blockHalfDiagonal_;
-    std::vector<uint8_t> inside(all.size());
+    std::vector<uint8_t>& inside = blockList_.inside;
+    inside.assign(all.size(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, all.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
             Block& b = all[i];
@@ -137,13 +141,15 @@ void VoxelStream::collectBlocks() {
     // order, whatever the thread count. A radix sort (util/radix_sort.h) of 64-bit keys (dMin's
     // bits, ≥ 0 so ordered as integers, then the id): the comparison sort of the blocks, its branches unpredictable,
     // took 0.3–0.5 ms of the far Engine's 5 (4 448 blocks).
-    std::vector<uint64_t> keys;
+    std::vector<uint64_t>& keys = blockList_.keys;
+    keys.clear();
     keys.reserve(all.size());
     for (size_t i = 0; i < all.size(); ++i) {
         if (inside[i]) keys.push_back(uint64_t(std::bit_cast<uint32_t>(all[i].dMin)) << 32 | all[i].id);
         else counts_.frustum += all[i].voxels;
     }
-    std::vector<uint64_t> scratch(keys.size());
+    std::vector<uint64_t>& scratch = blockList_.scratch;
+    scratch.resize(keys.size());
     const uint64_t* sorted = radixSortBits(keys.data(), scratch.data(), keys.size(), 0, 64);
     // The order as indices: the blocks stay where they are (a sorted copy of them was a fresh
     // 48 bytes a block, 52 page faults for the Engine's 4 448, 0.15 ms of a far render's 5).

@@ -233,12 +233,42 @@ struct PackedCells {
     const CellMoments& at(int i, int j) const { return cells[packed ? j : i]; }
 };
 
+/// @brief One block of the stream (VoxelStream's unit of culling, ordering and level of detail): a
+/// leaf, or 8³ voxels of an active tile.
+struct StreamBlock {
+    openvdb::Coord origin;          ///< min index corner
+    int dim;                        ///< side in voxels (8)
+    const openvdb::FloatTree::LeafNodeType* leaf;  ///< nullptr: an active tile block of tileValue
+    float tileValue;
+    float dMin, dMax;               ///< distance range of its voxel centres (world)
+    uint32_t voxels;                ///< active voxels
+    int lodLevel;                   ///< 0: voxel by voxel; L ≥ 1: aggregates of (2^L)³ cells
+    float lodFine;                  ///< blended: 1 − t, t the passage to lodLevel from lodLevel − 1 (0: lodLevel alone)
+    uint32_t id;                    ///< its place in the grid's leaf-then-tile order (the same every render)
+    bool pointsOnly = false;        ///< every voxel projects under pointBelowPx: all its records are points
+};
+
+/// @brief The block list VoxelStream builds for every render and what it builds it with (the
+/// leaves, their counts, the frustum test, the sort's keys), emptied and refilled each time. Kept
+/// with the other buffers, a second render of the grid allocates none of them: the Engine's 4 448
+/// blocks are 250 KB, fresh pages (71 faults, 0.7 ms of a 2.5 ms far render) when each render
+/// allocated its own (docs/performance.md, session 46).
+struct StreamBlocks {
+    std::vector<StreamBlock> all;   ///< every block, in the grid's order (StreamBlock::id is its index)
+    std::vector<uint32_t> order;    ///< the blocks in the frustum, front to back (dMin, then id)
+    std::vector<const openvdb::FloatTree::LeafNodeType*> leaves;
+    std::vector<uint32_t> onVoxels;
+    std::vector<uint8_t> inside;
+    std::vector<uint64_t> keys, scratch;
+};
+
 /// @brief The stream's voxel buffers. A caller rendering many images keeps them from one render
 /// to the next (render/hybrid.h, ForwardBuffers): they grow, never shrink, and are emptied or
 /// rewritten before use, so a render never depends on what they held.
 struct StreamBuffers {
     VoxelBatch pending, pendingNext;
     std::vector<VoxelBatch> extracted;
+    StreamBlocks blocks;     ///< the block list and its order
     LodMomentCache moments;  ///< only with StreamOptions::keepMoments
 };
 
@@ -275,18 +305,7 @@ public:
     double progress() const { return order_.empty() ? 1.0 : double(nextBlock_) / double(order_.size()); }
 
 private:
-    struct Block {
-        openvdb::Coord origin;          // min index corner
-        int dim;                        // side in voxels (8)
-        const openvdb::FloatTree::LeafNodeType* leaf;  // nullptr: an active tile block of tileValue
-        float tileValue;
-        float dMin, dMax;               // distance range of its voxel centres (world)
-        uint32_t voxels;                // active voxels
-        int lodLevel;                   // 0: voxel by voxel; L ≥ 1: aggregates of (2^L)³ cells
-        float lodFine;                  // blended: 1 − t, t the passage to lodLevel from lodLevel − 1 (0: lodLevel alone)
-        uint32_t id;                    // its place in the grid's leaf-then-tile order (the same every render)
-        bool pointsOnly = false;        // every voxel projects under pointBelowPx: all its records are points
-    };
+    using Block = StreamBlock;
     void collectBlocks();
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
@@ -329,11 +348,12 @@ private:
     const VoxelShader* shader_;
     const EmissionSource* emission_;
     double slabLength_;
-    std::vector<Block> blocks_;     // every block, in the grid's order (Block::id is its index)
-    std::vector<uint32_t> order_;   // the blocks in the frustum, front to back (dMin, then id)
+    std::unique_ptr<StreamBuffers> own_;  // the buffers, unless the caller keeps them
+    StreamBlocks& blockList_;       // the buffers' block list (blocks_ and order_ are its)
+    std::vector<Block>& blocks_;    // every block, in the grid's order (Block::id is its index)
+    std::vector<uint32_t>& order_;  // the blocks in the frustum, front to back (dMin, then id)
     const Block& block(size_t k) const { return blocks_[order_[k]]; }  // the k-th in order_
     size_t nextBlock_ = 0;
-    std::unique_ptr<StreamBuffers> own_;  // the buffers, unless the caller keeps them
     VoxelBatch& pending_;         // voxels of activated blocks not yet released
     VoxelBatch& pendingNext_;     // the pending voxels a window keeps (swapped with pending_)
     std::vector<VoxelBatch>& extracted_;  // per chunk of kExtractChunk activated blocks of the window (reused)

@@ -687,6 +687,8 @@ TEST(Forward, KeptBuffersDoNotChangeTheImage) {
         EXPECT_GT(energy, 1.0) << toString(c.mode) << " " << c.distance;  // something was drawn
     }
     EXPECT_GT(buffers.window.size, 0u);  // the renders went through the kept buffers
+    EXPECT_FALSE(buffers.stream.blocks.all.empty());  // the block list too (the last volume's)
+    EXPECT_FALSE(buffers.stream.blocks.order.empty());
 }
 
 // A render's page_faults count the fresh memory it touched: a render through kept buffers touches
