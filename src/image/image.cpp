@@ -262,6 +262,7 @@ WindowedImage::WindowedImage(Image window, int x0_, int y0_, int width_, int hei
 
 Image WindowedImage::full() const& {
     Image out(width, height);
+    if (data.width == 0 || data.height == 0) return out;
     adviseRowsWritten(out, y0, data.height, data.width);
     for (int v = 0; v < data.height; ++v)
         std::copy_n(&data.pixels[size_t(v) * size_t(data.width)], size_t(data.width), &out.at(x0, y0 + v));

@@ -18,6 +18,7 @@
 #include <ImfStringAttribute.h>
 #include <png.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <filesystem>
@@ -222,6 +223,12 @@ TEST(Image, WindowedImagePlacesItsWindowAndZerosTheRest) {
     // The whole window moves out as it is.
     const Image moved = WindowedImage(window).full();
     EXPECT_TRUE(std::equal(window.pixels.begin(), window.pixels.end(), moved.pixels.begin()));
+    // An empty window (no columns, or no rows) anywhere inside: all transparent.
+    for (const Image& empty : {Image(0, 3), Image(4, 0)}) {
+        const Image none = WindowedImage(empty, 9 - empty.width, 8 - empty.height, 9, 8).full();
+        ASSERT_EQ(none.pixels.size(), 72u);
+        EXPECT_TRUE(std::all_of(none.pixels.begin(), none.pixels.end(), [](const glm::vec4& p) { return p == glm::vec4(0.f); }));
+    }
     EXPECT_NE(errorOf([&] { WindowedImage(window, 5, 4, 9, 8); }).find("does not lie inside a 9x8 image"), std::string::npos);
     EXPECT_NE(errorOf([&] { WindowedImage(window, 2, 6, 9, 8); }).find("window at (2, 6)"), std::string::npos);
     EXPECT_NE(errorOf([&] { WindowedImage(window, -1, 0, 9, 8); }).find("does not lie inside"), std::string::npos);
