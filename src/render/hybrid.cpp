@@ -50,9 +50,10 @@ struct ForwardPass {
 using FrameSink = std::function<WindowedImage(const FrameView&)>;
 
 /// Streams, projects and composites @p volume onto @p camera's pixels; returns @p sink's image of the frame.
-WindowedImage composite(const Volume& volume, const ClassificationTable& table, const Camera& camera, PendingTables& pending,
-                const RenderSettings& settings, const ForwardPass& pass, RenderStats& stats,
-                const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission, const FrameSink& sink) {
+WindowedImage composite(const Volume& volume, const ClassificationTable& table, const Camera& camera,
+                        PendingTables& pending, const RenderSettings& settings, const ForwardPass& pass,
+                        RenderStats& stats, const VoxelShader* shader, const RenderControl& control,
+                        const EmissionSource* emission, const FrameSink& sink) {
     // The kernels' shape in view space (anisotropic or sheared voxels: ellipsoids).
     // view = R·(world − eye), R's rows right, up, forward: M = R·A.
     const glm::dmat3 worldToView = glm::transpose(glm::dmat3(camera.right(), camera.up(), camera.forward()));
@@ -212,8 +213,8 @@ WindowedImage placed(const FrameView& frame, int x0, int y0, int width, int heig
 }  // namespace
 
 WindowedImage renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
-                    PendingTables& tables, const RenderSettings& settings, RenderStats& stats,
-                    const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
+                            PendingTables& tables, const RenderSettings& settings, RenderStats& stats,
+                            const VoxelShader* shader, const RenderControl& control, const EmissionSource* emission) {
     // Fixed costs follow the pixels the volume covers, not the image: the compositor, its
     // tiles and the postfilter see only that rectangle (a cropped camera: the same rays, so the
     // same image there, up to the float rounding of pixel coordinates), and the image stores only

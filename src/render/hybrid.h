@@ -22,8 +22,8 @@ class PendingTables;  // render/pending_tables.h
 /// @return the image as its data window: the pixels the volume's primitives can reach (all of
 /// the image where no crop applies); transparent elsewhere.
 WindowedImage renderForward(const Volume& volume, const ClassificationTable& table, const Camera& camera,
-                    PendingTables& tables, const RenderSettings& settings, RenderStats& stats,
-                    const VoxelShader* shader = nullptr, const RenderControl& control = {},
-                    const EmissionSource* emission = nullptr);
+                            PendingTables& tables, const RenderSettings& settings, RenderStats& stats,
+                            const VoxelShader* shader = nullptr, const RenderControl& control = {},
+                            const EmissionSource* emission = nullptr);
 
 }  // namespace vdbsplat

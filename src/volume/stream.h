@@ -208,7 +208,7 @@ struct StreamCounts {
 struct LodMomentCache {
     static constexpr size_t kLevel1Budget = size_t(64) << 20;  ///< bytes for the level-1 cells, at most
     uint64_t key = 0;        ///< the grid and table the slots belong to (0: none yet)
-    size_t blocks = 0;       ///< block ids (VoxelStream::Block::id) the slots are for
+    size_t blocks = 0;       ///< block ids (StreamBlock::id) the slots are for
     bool level1 = false;     ///< level 1 kept (the blocks fit the budget)
     /// Per level 1–3, the cells with mass only (PackedCells), each filled block's packed together
     /// from offset[id] on, in the order its extraction claimed room (cursor); the pool has room for
