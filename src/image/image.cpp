@@ -274,34 +274,39 @@ Image WindowedImage::full() && {
     return static_cast<const WindowedImage&>(*this).full();
 }
 
-void writeImage(const std::string& path, const WindowedImage& image, const std::map<std::string, std::string>& metadata) {
+namespace {
+/// Checks @p path, then has @p write(tmp, ext) write the file to a temporary beside its target and
+/// renames it into place; a failure removes the temporary (nothing partial, nothing clobbered).
+template <class Write>
+void writeAtomically(const std::string& path, const Write& write) {
     checkImagePath(path);
-    if (extensionOf(path) != ".png") return writeImage(path, image.full(), metadata);
+    const std::string ext = extensionOf(path);
     const std::string target = resolveOutputPath(path);
-    const std::string tmp = temporaryPathFor(target, ".png");  // same folder: the rename is atomic
+    const std::string tmp = temporaryPathFor(target, ext);  // same folder: the rename is atomic
     try {
-        if (image.width < 1 || image.height < 1) throw Error(path + ": write failed: empty image");
-        writeFileBytes(tmp, path, encodePng(image));
+        write(tmp, ext);
         renameIntoPlace(tmp, target, path);
     } catch (...) {
         std::remove(tmp.c_str());
         throw;
     }
 }
+}  // namespace
+
+void writeImage(const std::string& path, const WindowedImage& image, const std::map<std::string, std::string>& metadata) {
+    checkImagePath(path);  // before full() builds an image for a path that would be refused
+    if (extensionOf(path) != ".png") return writeImage(path, image.full(), metadata);
+    writeAtomically(path, [&](const std::string& tmp, const std::string&) {
+        if (image.width < 1 || image.height < 1) throw Error(path + ": write failed: empty image");
+        writeFileBytes(tmp, path, encodePng(image));  // from the window and zeros (image/png_writer.h)
+    });
+}
 
 void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata) {
-    checkImagePath(path);
-    const std::string ext = extensionOf(path);
-    const std::string target = resolveOutputPath(path);
-    const std::string tmp = temporaryPathFor(target, ext);  // same folder: the rename is atomic
-    try {
+    writeAtomically(path, [&](const std::string& tmp, const std::string& ext) {
         if (ext == ".png") writePng(tmp, path, image);
         else writeExr(tmp, path, image, metadata);
-        renameIntoPlace(tmp, target, path);
-    } catch (...) {
-        std::remove(tmp.c_str());
-        throw;
-    }
+    });
 }
 
 Image readImage(const std::string& path) {
