@@ -520,7 +520,7 @@ int runAnimate(const Args& args) {
             ++skipped;
         } else {
             RenderStats st;
-            const WindowedImage im = renderWindowed(volume, tf, s, st, control);  // timed as `vdbsplat render` times it
+            WindowedImage im = renderWindowed(volume, tf, s, st, control);  // timed as `vdbsplat render` times it
             writeImage(framePath.string(), im,
                        {{"settings", s.toJson().dump()},
                         {"camera", cameras[i].describe()},
@@ -528,6 +528,7 @@ int runAnimate(const Args& args) {
                         {"transfer_function", tf.toJson()},
                         {"seconds", std::to_string(st.seconds)}});
             image = o.format == "png" ? readImage(framePath.string()) : im.full();  // metrics of the frame as written
+            buffers.recycle(std::move(im));  // its memory for the next frame
             FrameRecord r;
             r.frame = (long long)i;
             r.time = frames[i].time;

@@ -215,7 +215,7 @@ int runBench(const Args& args) {
             for (size_t mi = 0; mi < o.modes.size(); ++mi) {
                 Cell& cell = cells[di * o.modes.size() + mi];
                 RenderStats stats;
-                (void)renderWindowed(volume, tf, o.settingsFor(cell.distance, cell.mode), stats, control);
+                buffers.recycle(renderWindowed(volume, tf, o.settingsFor(cell.distance, cell.mode), stats, control));
                 if (o.verbose)
                     std::fprintf(stderr, "%s %d/%d  distance %-6s %-9s %.4f s\n", timed ? "run   " : "warmup",
                                  timed ? r - o.warmup + 1 : r + 1, timed ? o.runs : o.warmup,

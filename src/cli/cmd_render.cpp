@@ -125,7 +125,7 @@ int runRender(const Args& args) {
         quiet.progress = nullptr;
         for (int i = 0; i < warmup; ++i) {
             RenderStats untimed;
-            (void)renderWindowed(volume, tf, settings, untimed, quiet);
+            buffers.recycle(renderWindowed(volume, tf, settings, untimed, quiet));  // its memory for the next
         }
         image = renderWindowed(volume, tf, settings, stats, control);
     } catch (const RenderStopped&) {

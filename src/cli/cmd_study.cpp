@@ -334,7 +334,9 @@ Rendered makeRender(const fs::path& stem, const std::string& hash, const nlohman
     const RenderSettings s = resolvedFor(volume, camera, requested);  // --subpixels auto: the k used
     RenderStats st;
     Rendered r;
-    r.image = renderWindowed(volume, tf, s, st, control).full();  // timed as `vdbsplat render` times it
+    WindowedImage image = renderWindowed(volume, tf, s, st, control);  // timed as `vdbsplat render` times it
+    r.image = image.full();
+    if (control.buffers) control.buffers->recycle(std::move(image));  // its memory for the next render
     r.seconds = st.seconds;
     r.points = st.points;
     r.splats = st.splats;

@@ -198,10 +198,16 @@ double subpixelThreshold(double threshold, int k) {
     return std::min(threshold * k, std::max(threshold, kMaxPointSpacingSubpx));
 }
 
+/// A @p width × @p height image for a sink that writes every pixel of it: the caller's recycled
+/// memory (ForwardBuffers::takeImage), or a new image.
+Image sinkImage(const RenderControl& control, int width, int height) {
+    return control.buffers ? control.buffers->takeImage(width, height) : Image(width, height);
+}
+
 /// A @p width × @p height image, transparent (T = 1, no radiance) except for @p frame at (@p x0, @p y0):
-/// its data window, the frame's rows copied in parallel.
-WindowedImage placed(const FrameView& frame, int x0, int y0, int width, int height) {
-    Image window(frame.width, frame.height);
+/// its data window, the frame's rows copied in parallel (into sinkImage's memory).
+WindowedImage placed(const FrameView& frame, int x0, int y0, int width, int height, const RenderControl& control) {
+    Image window = sinkImage(control, frame.width, frame.height);
     adviseRowsWritten(window, 0, frame.height, frame.width);
     tbb::parallel_for(tbb::blocked_range<int>(0, frame.height, 16), [&](const tbb::blocked_range<int>& r) {
         for (int y = r.begin(); y < r.end(); ++y)
@@ -227,7 +233,9 @@ WindowedImage renderForward(const Volume& volume, const ClassificationTable& tab
         const ForwardPass pass{settings.threshold, none ? 0.0 : settings.lodPx, none ? 0.0 : settings.effectiveLodCoarsePx(), v, v, v};
         const std::optional<PixelRange> crop = coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, tables.kernel()), 0);
         const auto at = [&](int x0, int y0) {
-            return [&camera, x0, y0](const FrameView& f) { return placed(f, x0, y0, camera.width(), camera.height()); };
+            return [&camera, &control, x0, y0](const FrameView& f) {
+                return placed(f, x0, y0, camera.width(), camera.height(), control);
+            };
         };
         if (!crop) return composite(volume, table, camera, tables, settings, pass, stats, shader, control, emission, at(0, 0));
         const int w = crop->x1 - crop->x0 + 1, h = crop->y1 - crop->y0 + 1;
@@ -249,8 +257,8 @@ WindowedImage renderForward(const Volume& volume, const ClassificationTable& tab
         coveredPixels(volume, camera, settings, depositReachPx(pass.prefilterVariance, tables.kernel()), grid.border);
     // The postfilter reads the compositor's frame and writes the output image's data window.
     const auto filtered = [&](int x0, int y0, int w, int h) {
-        return [&camera, &grid, x0, y0, w, h](const FrameView& f) {
-            Image window(w, h);
+        return [&camera, &grid, &control, x0, y0, w, h](const FrameView& f) {
+            Image window = sinkImage(control, w, h);  // postfilterInto writes every pixel
             postfilterInto(f, grid, w, h, window, 0, 0);
             return WindowedImage(std::move(window), x0, y0, camera.width(), camera.height());
         };

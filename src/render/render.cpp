@@ -7,10 +7,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
 #include "footprint/tables.h"
+#include "render/forward_buffers.h"
 #include "render/hybrid.h"
 #include "render/pending_tables.h"
 #include "render/reference.h"
@@ -108,10 +110,17 @@ WindowedImage renderWindowed(const Volume& volume, const TransferFunction& tf, c
     checkKernelShape(volume, requested);
     // The forward modes' tables are read on a worker while this thread bakes the transfer
     // function and renderForward sets up the stream (render/pending_tables.h).
+    // Kept buffers lend the tables an earlier render read, for the same directory and kernel.
     std::optional<PendingTables> tables;
-    if (requested.mode != RenderMode::Reference)
-        tables.emplace(requested.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(requested.tablesDir),
-                       KernelShape::named(requested.kernel));
+    const std::filesystem::path tablesDir = requested.tablesDir.empty() ? defaultTablesDir() : std::filesystem::path(requested.tablesDir);
+    ForwardBuffers* kept = control.buffers;
+    if (requested.mode != RenderMode::Reference) {
+        const KernelShape& kernel = KernelShape::named(requested.kernel);
+        if (kept && kept->tables && kept->tables->dir == tablesDir && kept->tables->kernel == &kernel)
+            tables.emplace(kept->tables->tables, kernel);
+        else
+            tables.emplace(tablesDir, kernel);
+    }
     float lo, hi;
     normalizationRange(volume, lo, hi);
     const ClassificationTable table = tf.bake(lo, hi, volume.voxelSize);
@@ -146,6 +155,7 @@ WindowedImage renderWindowed(const Volume& volume, const TransferFunction& tf, c
         case RenderMode::Swan:
         case RenderMode::None: {
             image = renderForward(volume, table, camera, *tables, settings, stats, shader.get(), control, emission.get());
+            if (kept) kept->tables = ForwardBuffers::KeptTables{tablesDir, &tables->kernel(), tables->shared()};
             break;
         }
     }

@@ -89,6 +89,18 @@ VoxelStream::VoxelStream(const Volume& volume, const Camera& camera, const Class
 
 void VoxelStream::collectBlocks() {
     const auto& tree = *volume_.tree;
+    std::vector<Block>& all = blocks_;  // in the grid's order: a block's id is its place here
+    const uint64_t leafCount = tree.leafCount();
+    const bool listed = !all.empty() && blockList_.listedTree.lock() == volume_.tree &&
+                        blockList_.listedVoxels == volume_.activeVoxels && blockList_.listedLeaves == leafCount;
+    if (!listed) listBlocks(leafCount);
+    if (moments_) prepareMomentCache(all.size());
+    frameBlocks();
+}
+
+void VoxelStream::listBlocks(uint64_t leafCount) {
+    const auto& tree = *volume_.tree;
+    blockList_.listedTree.reset();  // until the list is whole
     // The leaves from the internal nodes' tables (the leaf iterator's order), their voxel counts in
     // parallel: each count reads a leaf's mask for the first time since the load, and the iterator
     // walked them one dependent miss after another (0.5 ms of the far Engine's 10).
@@ -101,7 +113,7 @@ void VoxelStream::collectBlocks() {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) onVoxels[i] = uint32_t(leaves[i]->onVoxelCount());
     });
-    std::vector<Block>& all = blocks_;  // in the grid's order: a block's id is its place here
+    std::vector<Block>& all = blocks_;
     all.clear();
     all.reserve(leaves.size());
     for (size_t i = 0; i < leaves.size(); ++i)
@@ -119,7 +131,12 @@ void VoxelStream::collectBlocks() {
                     all.push_back({openvdb::Coord(x, y, z), kBlockDim, nullptr, *it, 0.f, 0.f,
                                    uint32_t(kBlockDim * kBlockDim * kBlockDim), 0, 0.f, uint32_t(all.size())});
     }
-    if (moments_) prepareMomentCache(all.size());
+    blockList_.listedTree = volume_.tree;
+    blockList_.listedVoxels = volume_.activeVoxels, blockList_.listedLeaves = leafCount;
+}
+
+void VoxelStream::frameBlocks() {
+    std::vector<Block>& all = blocks_;
     // Distance bounds of voxel centres (the block's bounding sphere around its centre), the frustum
     // test and the level of detail, block by block in parallel (each writes only its own block).
     const double halfDiagonal = blockHalfDiagonal_;
@@ -135,6 +152,7 @@ void VoxelStream::collectBlocks() {
             b.dMax = float(dist + halfDiagonal);
             inside[i] = visible(b);
             if (inside[i]) lodLevel(b);
+            else b.lodLevel = 0, b.lodFine = 0.f, b.pointsOnly = false;  // a kept list's last view's
         }
     });
     // Front to back by nearest distance, ties in the grid's order (the blocks' ids): one total
@@ -574,7 +592,7 @@ void VoxelStream::prepareMomentCache(size_t blocks) {
     key = fnv1a64(&tree, sizeof tree, key);
     key = fnv1a64(counts, sizeof counts, key);
     key = fnv1a64(&volume_.indexToWorld, sizeof volume_.indexToWorld, key);
-    key = fnv1a64(table_.entries(), sizeof(Classified) * ClassificationTable::kSize, key);
+    key = fnv1a64Words(table_.entries(), sizeof(Classified) * ClassificationTable::kSize, key);
     const float map[2] = {table_.scale(), table_.offset()};
     key = fnv1a64(map, sizeof map, key);
     const LinearPieces& pieces = table_.pieces();  // what classifies, where it has pieces (not its padding)

@@ -254,6 +254,12 @@ struct StreamBlock {
 /// blocks are 250 KB, fresh pages (71 faults, 0.7 ms of a 2.5 ms far render) when each render
 /// allocated its own (docs/performance.md, session 46).
 struct StreamBlocks {
+    /// The tree `all` was listed from, with its active voxel and leaf counts: a render of the same
+    /// live tree keeps the list (the leaves, their counts, the active tiles' blocks: the grid's
+    /// topology) and computes only what the view decides (VoxelStream::collectBlocks). Expired or
+    /// another tree: listed again. A tree edited in place between renders must not keep its list.
+    std::weak_ptr<const openvdb::FloatTree> listedTree;
+    uint64_t listedVoxels = 0, listedLeaves = 0;
     std::vector<StreamBlock> all;   ///< every block, in the grid's order (StreamBlock::id is its index)
     std::vector<uint32_t> order;    ///< the blocks in the frustum, front to back (dMin, then id)
     std::vector<const openvdb::FloatTree::LeafNodeType*> leaves;
@@ -306,7 +312,13 @@ public:
 
 private:
     using Block = StreamBlock;
+    /// The block list (listBlocks, unless the kept list is this tree's), then frameBlocks.
     void collectBlocks();
+    /// Lists the grid's blocks: its leaves with active voxels, then its active tiles' 8³ blocks.
+    void listBlocks(uint64_t leafCount);
+    /// What the view decides of each block: its distance bounds, the frustum test, the level of
+    /// detail; then the blocks in the frustum, front to back (order_).
+    void frameBlocks();
     bool visible(const Block& b) const;
     void screenRect(const Block& b, int& x0, int& y0, int& x1, int& y1) const;
     /// The pixels the deposits of the voxels [origin, origin + dim)³ can reach: the box of their

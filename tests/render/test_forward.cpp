@@ -659,13 +659,17 @@ TEST(Forward, CutoffDropsLessThanItsBound) {
 TEST(Forward, KeptBuffersDoNotChangeTheImage) {
     const TransferFunction tf = TransferFunction::preset("grey");
     const Volume box = boxVolume(openvdb::Coord(0), openvdb::Coord(19), 0.6f);
-    struct Case { const Volume* volume; RenderMode mode; double distance; int size; CompositingOrder order; };
+    struct Case {
+        const Volume* volume; RenderMode mode; double distance; int size; CompositingOrder order;
+        FilterOrder filter = FilterOrder::Postfilter;
+    };
     const Case cases[] = {
         {&marschnerLobb(), RenderMode::Splat, 0.35, 128, CompositingOrder::Kernels},  // the largest first
         {&marschnerLobb(), RenderMode::Hybrid, 1.0, 96, CompositingOrder::Kernels},
         {&box, RenderMode::Hybrid, 1.0, 64, CompositingOrder::Slabs},
         {&marschnerLobb(), RenderMode::Hybrid, 8.0, 72, CompositingOrder::Kernels},  // level of detail
         {&marschnerLobb(), RenderMode::Point, 1.0, 96, CompositingOrder::Kernels},
+        {&marschnerLobb(), RenderMode::Hybrid, 2.0, 96, CompositingOrder::Kernels, FilterOrder::Prefilter},
         {&box, RenderMode::Splat, 0.5, 160, CompositingOrder::Kernels},  // then larger again
         {&marschnerLobb(), RenderMode::Hybrid, 1.0, 96, CompositingOrder::Kernels},
     };
@@ -675,9 +679,14 @@ TEST(Forward, KeptBuffersDoNotChangeTheImage) {
     for (const Case& c : cases) {
         RenderSettings s = settingsFor(c.mode, c.distance, c.size);
         s.compositing = c.order;
+        s.filterOrder = c.filter;
         const Image fresh = renderWith(*c.volume, tf, s);
         RenderStats stats;
-        const Image kept = render(*c.volume, tf, s, stats, control);
+        // Each image is given back (as bench, animate, study and render --warmup do): the next
+        // render writes its window into that memory, over the previous image's pixels.
+        WindowedImage windowed = renderWindowed(*c.volume, tf, s, stats, control);
+        const Image kept = windowed.full();
+        buffers.recycle(std::move(windowed));
         ASSERT_EQ(fresh.pixels.size(), kept.pixels.size());
         double energy = 0.0;
         for (size_t i = 0; i < fresh.pixels.size(); ++i) {
@@ -689,6 +698,83 @@ TEST(Forward, KeptBuffersDoNotChangeTheImage) {
     EXPECT_GT(buffers.window.size, 0u);  // the renders went through the kept buffers
     EXPECT_FALSE(buffers.stream.blocks.all.empty());  // the block list too (the last volume's)
     EXPECT_FALSE(buffers.stream.blocks.order.empty());
+    ASSERT_TRUE(buffers.tables);  // and the tables the first render read
+    EXPECT_TRUE(buffers.tables->tables);
+}
+
+// A recycled image's memory holds the next render's data window (no fresh pages), every pixel of
+// it written: a smaller window after a larger one, and a larger one after that (new memory).
+TEST(Forward, RecycledImageMemoryHoldsTheNextWindow) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    ForwardBuffers buffers;
+    RenderControl control;
+    control.buffers = &buffers;
+    RenderStats stats;
+    WindowedImage large = renderWindowed(marschnerLobb(), tf, settingsFor(RenderMode::Hybrid, 0.7, 96), stats, control);
+    ASSERT_GT(large.data.pixels.size(), 0u);
+    const glm::vec4* memory = large.data.pixels.data();
+    buffers.recycle(std::move(large));
+    const RenderSettings far = settingsFor(RenderMode::Hybrid, 3.0, 96);
+    const WindowedImage small = renderWindowed(marschnerLobb(), tf, far, stats, control);
+    ASSERT_GT(small.data.pixels.size(), 0u);
+    EXPECT_LT(small.data.pixels.size(), size_t(96 * 96));  // a data window, not the whole image
+    EXPECT_EQ(small.data.pixels.data(), memory);
+    const Image fresh = renderWith(marschnerLobb(), tf, far);
+    const Image kept = small.full();
+    ASSERT_EQ(fresh.pixels.size(), kept.pixels.size());
+    for (size_t i = 0; i < fresh.pixels.size(); ++i) ASSERT_EQ(fresh.pixels[i], kept.pixels[i]) << "pixel " << i;
+    WindowedImage smaller = renderWindowed(marschnerLobb(), tf, settingsFor(RenderMode::Hybrid, 6.0, 96), stats, control);
+    buffers.recycle(std::move(smaller));
+    const RenderSettings close = settingsFor(RenderMode::Hybrid, 0.5, 96);
+    const WindowedImage whole = renderWindowed(marschnerLobb(), tf, close, stats, control);
+    EXPECT_EQ(whole.full().pixels, renderWith(marschnerLobb(), tf, close).pixels);
+}
+
+// Kept buffers keep the block list of a live tree (its topology) and list a new tree's blocks,
+// also one allocated where a freed tree was (the list holds leaf pointers: a stale one would read
+// freed memory); each image is a fresh render's.
+TEST(Forward, KeptBlockListIsTheLiveTreesOnly) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    const RenderSettings s = settingsFor(RenderMode::Hybrid, 1.5, 64);
+    ForwardBuffers buffers;
+    RenderControl control;
+    control.buffers = &buffers;
+    RenderStats stats;
+    for (int round = 0; round < 3; ++round) {
+        const float density = 0.3f + 0.2f * float(round);
+        const Volume box = boxVolume(openvdb::Coord(0), openvdb::Coord(13), density);  // the same topology each time
+        (void)renderWindowed(box, tf, s, stats, control);
+        EXPECT_EQ(buffers.stream.blocks.listedTree.lock(), box.tree) << round;
+        const std::vector<StreamBlock> listed = buffers.stream.blocks.all;
+        const Image kept = render(box, tf, s, stats, control);  // the kept list
+        EXPECT_EQ(buffers.stream.blocks.all.size(), listed.size());
+        EXPECT_EQ(buffers.stream.blocks.all.front().leaf, listed.front().leaf);
+        EXPECT_EQ(kept.pixels, renderWith(box, tf, s).pixels) << round;
+    }
+    EXPECT_TRUE(buffers.stream.blocks.listedTree.expired());  // the last box is gone
+}
+
+// Kept buffers read the footprint tables once: the next render with the same directory and kernel
+// takes them, another kernel reads its own.
+TEST(Forward, KeptBuffersReadTheTablesOnce) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    ForwardBuffers buffers;
+    RenderControl control;
+    control.buffers = &buffers;
+    RenderStats stats;
+    RenderSettings s = settingsFor(RenderMode::Hybrid, 2.0, 48);
+    (void)renderWindowed(marschnerLobb(), tf, s, stats, control);
+    ASSERT_TRUE(buffers.tables);
+    const Tables* first = buffers.tables->tables.get();
+    EXPECT_EQ(buffers.tables->kernel, &KernelShape::standard());
+    (void)renderWindowed(marschnerLobb(), tf, settingsFor(RenderMode::Splat, 1.0, 64), stats, control);
+    EXPECT_EQ(buffers.tables->tables.get(), first);  // the same tables, not read again
+    s.kernel = KernelShape::sharp().id();
+    const Image sharp = render(marschnerLobb(), tf, s, stats, control);
+    EXPECT_NE(buffers.tables->tables.get(), first);
+    EXPECT_EQ(buffers.tables->kernel, &KernelShape::sharp());
+    EXPECT_EQ(buffers.tables->tables->kernel, &KernelShape::sharp());
+    EXPECT_EQ(sharp.pixels, renderWith(marschnerLobb(), tf, s).pixels);  // its own tables' image
 }
 
 // A render's page_faults count the fresh memory it touched: a render through kept buffers touches
