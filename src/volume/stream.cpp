@@ -911,6 +911,7 @@ void VoxelStream::release(size_t blocks, float limit, StreamWindow& window) {
         if (n > 0) window.sources.push_back({s < pendingChunks ? &pendingNext_ : &src, begin, released[s], n});  // pending: swapped below
     }
     std::swap(pending_, pendingNext_);
+    pendingSwapped_ = !pendingSwapped_;
 }
 
 bool VoxelStream::next(VoxelBatch& batch, const std::function<bool(int, int, int, int)>& hidden,
@@ -934,7 +935,13 @@ bool VoxelStream::next(StreamWindow& window, const std::function<bool(int, int, 
     if (pending_.viewPos.capacity() < room) pending_.reserve(room, options_.depthSpread), pendingNext_.reserve(room, options_.depthSpread);
     while (true) {
         if (pending_.size() == 0) {
-            if (nextBlock_ >= order_.size()) return false;
+            if (nextBlock_ >= order_.size()) {
+                // The two pending buffers back in their places (an odd number of windows swapped
+                // them): the next render of the view writes each where this one did, in pages it
+                // touched, instead of the other's (19 fresh pages of a warm far checker box, 1024²).
+                if (pendingSwapped_) std::swap(pending_, pendingNext_), pendingSwapped_ = false;
+                return false;
+            }
             // Skip empty depth: jump to the next block's front.
             nextSlab_ = std::max<int64_t>(nextSlab_, int64_t(std::floor(block(nextBlock_).dMin / slabLength_)));
         }

@@ -376,6 +376,7 @@ private:
     int64_t nextSlab_ = 0;
     size_t records_ = 0;          // about how many records the blocks give (recordsOf), once known
     int slabsPerWindow_ = 8;      // adapted between 1 and options_.slabsPerWindow (maxWindowVoxels)
+    bool pendingSwapped_ = false;  // pending_ and pendingNext_ hold each other's buffers (release)
     glm::dmat4 indexToView_{1.0};  // index space → view space (eye at origin, +z forward)
     // The voxel's shape in world units (volume/grid.h: any affine map): the largest semi-axis
     // per index unit (the kernel's bounding sphere is R·this) and the half-diagonal of a block's

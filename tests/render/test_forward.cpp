@@ -754,6 +754,28 @@ TEST(Forward, KeptBlockListIsTheLiveTreesOnly) {
     EXPECT_TRUE(buffers.stream.blocks.listedTree.expired());  // the last box is gone
 }
 
+// Each window swaps the stream's two pending buffers; a render ends with them back in their places,
+// so the next render of the view writes each where this one did (pages it touched already).
+TEST(Forward, KeptPendingBuffersEndInTheirPlaces) {
+    const TransferFunction tf = TransferFunction::preset("grey");
+    ForwardBuffers buffers;
+    RenderControl control;
+    control.buffers = &buffers;
+    bool oddSeen = false;
+    for (const double distance : {8.0, 3.0, 1.5, 1.0, 0.7}) {
+        const RenderSettings s = settingsFor(RenderMode::Hybrid, distance, 128);
+        RenderStats stats;
+        (void)renderWindowed(marschnerLobb(), tf, s, stats, control);
+        const VoxelBatch& pending = buffers.stream.pending;
+        const glm::vec3 *first = pending.viewPos.data(), *other = buffers.stream.pendingNext.viewPos.data();
+        (void)renderWindowed(marschnerLobb(), tf, s, stats, control);
+        EXPECT_EQ(pending.viewPos.data(), first) << distance << ": " << stats.windows << " windows";
+        EXPECT_EQ(buffers.stream.pendingNext.viewPos.data(), other) << distance;
+        oddSeen |= stats.windows >= 3 && stats.windows % 2 == 1;
+    }
+    EXPECT_TRUE(oddSeen);  // a view that swapped them an odd number of times
+}
+
 // Kept buffers read the footprint tables once: the next render with the same directory and kernel
 // takes them, another kernel reads its own.
 TEST(Forward, KeptBuffersReadTheTablesOnce) {
