@@ -2,8 +2,9 @@
 // Owns: ForwardBuffers, every large buffer of renderForward (render/hybrid.h): the projected
 // window, the stream's block list and its extracted and pending voxels (a window reads them
 // there), the compositor's frame, sort and bins; the footprint tables read for the first render
-// (KeptTables) and an output image the caller is done with (recycle). A command that renders many images (bench,
-// animate, study) keeps one and passes it in RenderControl::buffers; a single render needs none.
+// (KeptTables) and an output image the caller is done with (recycle). A command that renders many
+// images (bench, animate, study, render --warmup) keeps one and passes it in
+// RenderControl::buffers; a single render needs none.
 //
 // Why: on the virtual machines this project is measured on, the first touch of fresh memory is
 // the cost, not the allocation (util/huge_pages.h). A framed Engine render touches ~40 MB of it;

@@ -1,6 +1,7 @@
-// util/fnv1a.h — FNV-1a 64, the one fingerprint the project uses (table checksums, study and
-// animation folders' camera and settings fingerprints). Not cryptographic: it tells a changed
-// input from an unchanged one, nothing more.
+// util/fnv1a.h — FNV-1a 64, the fingerprint the project uses (table checksums, study and
+// animation folders' camera and settings fingerprints), and its word-wise form for large arrays in
+// memory (fnv1a64Words: cache keys). Not cryptographic: they tell a changed input from an
+// unchanged one, nothing more.
 #pragma once
 #include <cstddef>
 #include <cstdint>
