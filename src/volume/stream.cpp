@@ -106,7 +106,7 @@ void VoxelStream::listBlocks(uint64_t leafCount) {
     // walked them one dependent miss after another (0.5 ms of the far Engine's 10).
     std::vector<const openvdb::FloatTree::LeafNodeType*>& leaves = blockList_.leaves;
     leaves.clear();
-    leaves.reserve(tree.leafCount());
+    leaves.reserve(leafCount);
     tree.getNodes(leaves);
     std::vector<uint32_t>& onVoxels = blockList_.onVoxels;
     onVoxels.resize(leaves.size());

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 
 #include "metrics/metrics.h"
 #include "render/forward_buffers.h"
@@ -702,76 +703,78 @@ TEST(Forward, KeptBuffersDoNotChangeTheImage) {
     EXPECT_TRUE(buffers.tables->tables);
 }
 
-// A recycled image's memory holds the next render's data window (no fresh pages), every pixel of
-// it written: a smaller window after a larger one, and a larger one after that (new memory).
-TEST(Forward, RecycledImageMemoryHoldsTheNextWindow) {
+/// Renders with the grey transfer function through one set of kept buffers, as bench, animate,
+/// study and render --warmup do.
+struct KeptRenders {
     const TransferFunction tf = TransferFunction::preset("grey");
     ForwardBuffers buffers;
     RenderControl control;
-    control.buffers = &buffers;
     RenderStats stats;
-    WindowedImage large = renderWindowed(marschnerLobb(), tf, settingsFor(RenderMode::Hybrid, 0.7, 96), stats, control);
+    KeptRenders() { control.buffers = &buffers; }
+    KeptRenders(const KeptRenders&) = delete;  // control points at this one's buffers
+    KeptRenders& operator=(const KeptRenders&) = delete;
+    WindowedImage windowed(const Volume& v, const RenderSettings& s) { return renderWindowed(v, tf, s, stats, control); }
+    Image image(const Volume& v, const RenderSettings& s) { return render(v, tf, s, stats, control); }
+    Image fresh(const Volume& v, const RenderSettings& s) const { return renderWith(v, tf, s); }
+};
+
+// A recycled image's memory holds the next render's data window (no fresh pages), every pixel of
+// it written: a smaller window after a larger one, and a larger one after that (new memory).
+TEST(Forward, RecycledImageMemoryHoldsTheNextWindow) {
+    KeptRenders kept;
+    WindowedImage large = kept.windowed(marschnerLobb(), settingsFor(RenderMode::Hybrid, 0.7, 96));
     ASSERT_GT(large.data.pixels.size(), 0u);
     const glm::vec4* memory = large.data.pixels.data();
-    buffers.recycle(std::move(large));
+    kept.buffers.recycle(std::move(large));
     const RenderSettings far = settingsFor(RenderMode::Hybrid, 3.0, 96);
-    const WindowedImage small = renderWindowed(marschnerLobb(), tf, far, stats, control);
+    const WindowedImage small = kept.windowed(marschnerLobb(), far);
     ASSERT_GT(small.data.pixels.size(), 0u);
     EXPECT_LT(small.data.pixels.size(), size_t(96 * 96));  // a data window, not the whole image
     EXPECT_EQ(small.data.pixels.data(), memory);
-    const Image fresh = renderWith(marschnerLobb(), tf, far);
-    const Image kept = small.full();
-    ASSERT_EQ(fresh.pixels.size(), kept.pixels.size());
-    for (size_t i = 0; i < fresh.pixels.size(); ++i) ASSERT_EQ(fresh.pixels[i], kept.pixels[i]) << "pixel " << i;
-    WindowedImage smaller = renderWindowed(marschnerLobb(), tf, settingsFor(RenderMode::Hybrid, 6.0, 96), stats, control);
-    buffers.recycle(std::move(smaller));
+    const Image fresh = kept.fresh(marschnerLobb(), far);
+    const Image placed = small.full();
+    ASSERT_EQ(fresh.pixels.size(), placed.pixels.size());
+    for (size_t i = 0; i < fresh.pixels.size(); ++i) ASSERT_EQ(fresh.pixels[i], placed.pixels[i]) << "pixel " << i;
+    kept.buffers.recycle(kept.windowed(marschnerLobb(), settingsFor(RenderMode::Hybrid, 6.0, 96)));
     const RenderSettings close = settingsFor(RenderMode::Hybrid, 0.5, 96);
-    const WindowedImage whole = renderWindowed(marschnerLobb(), tf, close, stats, control);
-    EXPECT_EQ(whole.full().pixels, renderWith(marschnerLobb(), tf, close).pixels);
+    EXPECT_EQ(kept.windowed(marschnerLobb(), close).full().pixels, kept.fresh(marschnerLobb(), close).pixels);
 }
 
 // Kept buffers keep the block list of a live tree (its topology) and list a new tree's blocks,
 // also one allocated where a freed tree was (the list holds leaf pointers: a stale one would read
 // freed memory); each image is a fresh render's.
 TEST(Forward, KeptBlockListIsTheLiveTreesOnly) {
-    const TransferFunction tf = TransferFunction::preset("grey");
     const RenderSettings s = settingsFor(RenderMode::Hybrid, 1.5, 64);
-    ForwardBuffers buffers;
-    RenderControl control;
-    control.buffers = &buffers;
-    RenderStats stats;
+    KeptRenders kept;
+    const StreamBlocks& blocks = kept.buffers.stream.blocks;
     for (int round = 0; round < 3; ++round) {
         const float density = 0.3f + 0.2f * float(round);
         const Volume box = boxVolume(openvdb::Coord(0), openvdb::Coord(13), density);  // the same topology each time
-        (void)renderWindowed(box, tf, s, stats, control);
-        EXPECT_EQ(buffers.stream.blocks.listedTree.lock(), box.tree) << round;
-        const std::vector<StreamBlock> listed = buffers.stream.blocks.all;
-        const Image kept = render(box, tf, s, stats, control);  // the kept list
-        EXPECT_EQ(buffers.stream.blocks.all.size(), listed.size());
-        EXPECT_EQ(buffers.stream.blocks.all.front().leaf, listed.front().leaf);
-        EXPECT_EQ(kept.pixels, renderWith(box, tf, s).pixels) << round;
+        (void)kept.windowed(box, s);
+        EXPECT_EQ(blocks.listedTree.lock(), box.tree) << round;
+        const std::vector<StreamBlock> listed = blocks.all;
+        const Image image = kept.image(box, s);  // the kept list
+        EXPECT_EQ(blocks.all.size(), listed.size());
+        EXPECT_EQ(blocks.all.front().leaf, listed.front().leaf);
+        EXPECT_EQ(image.pixels, kept.fresh(box, s).pixels) << round;
     }
-    EXPECT_TRUE(buffers.stream.blocks.listedTree.expired());  // the last box is gone
+    EXPECT_TRUE(blocks.listedTree.expired());  // the last box is gone
 }
 
 // Each window swaps the stream's two pending buffers; a render ends with them back in their places,
 // so the next render of the view writes each where this one did (pages it touched already).
 TEST(Forward, KeptPendingBuffersEndInTheirPlaces) {
-    const TransferFunction tf = TransferFunction::preset("grey");
-    ForwardBuffers buffers;
-    RenderControl control;
-    control.buffers = &buffers;
+    KeptRenders kept;
+    const VoxelBatch &pending = kept.buffers.stream.pending, &pendingNext = kept.buffers.stream.pendingNext;
     bool oddSeen = false;
     for (const double distance : {8.0, 3.0, 1.5, 1.0, 0.7}) {
         const RenderSettings s = settingsFor(RenderMode::Hybrid, distance, 128);
-        RenderStats stats;
-        (void)renderWindowed(marschnerLobb(), tf, s, stats, control);
-        const VoxelBatch& pending = buffers.stream.pending;
-        const glm::vec3 *first = pending.viewPos.data(), *other = buffers.stream.pendingNext.viewPos.data();
-        (void)renderWindowed(marschnerLobb(), tf, s, stats, control);
-        EXPECT_EQ(pending.viewPos.data(), first) << distance << ": " << stats.windows << " windows";
-        EXPECT_EQ(buffers.stream.pendingNext.viewPos.data(), other) << distance;
-        oddSeen |= stats.windows >= 3 && stats.windows % 2 == 1;
+        (void)kept.windowed(marschnerLobb(), s);
+        const glm::vec3 *first = pending.viewPos.data(), *other = pendingNext.viewPos.data();
+        (void)kept.windowed(marschnerLobb(), s);
+        EXPECT_EQ(pending.viewPos.data(), first) << distance << ": " << kept.stats.windows << " windows";
+        EXPECT_EQ(pendingNext.viewPos.data(), other) << distance;
+        oddSeen |= kept.stats.windows >= 3 && kept.stats.windows % 2 == 1;
     }
     EXPECT_TRUE(oddSeen);  // a view that swapped them an odd number of times
 }
@@ -779,24 +782,21 @@ TEST(Forward, KeptPendingBuffersEndInTheirPlaces) {
 // Kept buffers read the footprint tables once: the next render with the same directory and kernel
 // takes them, another kernel reads its own.
 TEST(Forward, KeptBuffersReadTheTablesOnce) {
-    const TransferFunction tf = TransferFunction::preset("grey");
-    ForwardBuffers buffers;
-    RenderControl control;
-    control.buffers = &buffers;
-    RenderStats stats;
+    KeptRenders kept;
+    const std::optional<ForwardBuffers::KeptTables>& tables = kept.buffers.tables;
     RenderSettings s = settingsFor(RenderMode::Hybrid, 2.0, 48);
-    (void)renderWindowed(marschnerLobb(), tf, s, stats, control);
-    ASSERT_TRUE(buffers.tables);
-    const Tables* first = buffers.tables->tables.get();
-    EXPECT_EQ(buffers.tables->kernel, &KernelShape::standard());
-    (void)renderWindowed(marschnerLobb(), tf, settingsFor(RenderMode::Splat, 1.0, 64), stats, control);
-    EXPECT_EQ(buffers.tables->tables.get(), first);  // the same tables, not read again
+    (void)kept.windowed(marschnerLobb(), s);
+    ASSERT_TRUE(tables);
+    const Tables* first = tables->tables.get();
+    EXPECT_EQ(tables->kernel, &KernelShape::standard());
+    (void)kept.windowed(marschnerLobb(), settingsFor(RenderMode::Splat, 1.0, 64));
+    EXPECT_EQ(tables->tables.get(), first);  // the same tables, not read again
     s.kernel = KernelShape::sharp().id();
-    const Image sharp = render(marschnerLobb(), tf, s, stats, control);
-    EXPECT_NE(buffers.tables->tables.get(), first);
-    EXPECT_EQ(buffers.tables->kernel, &KernelShape::sharp());
-    EXPECT_EQ(buffers.tables->tables->kernel, &KernelShape::sharp());
-    EXPECT_EQ(sharp.pixels, renderWith(marschnerLobb(), tf, s).pixels);  // its own tables' image
+    const Image sharp = kept.image(marschnerLobb(), s);
+    EXPECT_NE(tables->tables.get(), first);
+    EXPECT_EQ(tables->kernel, &KernelShape::sharp());
+    EXPECT_EQ(tables->tables->kernel, &KernelShape::sharp());
+    EXPECT_EQ(sharp.pixels, kept.fresh(marschnerLobb(), s).pixels);  // its own tables' image
 }
 
 // A render's page_faults count the fresh memory it touched: a render through kept buffers touches
